@@ -1,0 +1,16 @@
+#pragma once
+// Each subcommand registers its options on the app and returns what to run once parsing is done.
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace pneumo::cli {
+
+using Run = std::function<int()>;   // returns the exit code
+
+Run add_info(CLI::App& app);
+Run add_devices(CLI::App& app);
+Run add_phantom(CLI::App& app);
+Run add_scene(CLI::App& app);
+
+}  // namespace pneumo::cli

@@ -1,0 +1,63 @@
+// pneumo: one executable whose subcommands map one to one onto library calls.
+// Exit codes: 0 success, 1 failure, 2 bad input (a file, a scene, an argument).
+#include <cstdio>
+#include <iostream>
+#include <vector>
+
+#include "cli/commands.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "core/progress.h"
+
+namespace {
+constexpr int kExitFailure = 1;
+constexpr int kExitBadInput = 2;
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace pneumo;
+  CLI::App app{"pneumo: virtual pneumoperitoneum, from a CT to the laparoscope's view"};
+  app.set_version_flag("--version", std::string("pneumo ") + PNEUMO_VERSION);
+  app.require_subcommand(1);
+  bool verbose = false, quiet = false;
+  app.add_flag("-v,--verbose", verbose, "Show debug messages (device, build options, timings)");
+  app.add_flag("-q,--quiet", quiet, "Show errors only (no progress)");
+
+  std::vector<std::pair<CLI::App*, cli::Run>> commands;
+  auto add = [&](cli::Run (*make)(CLI::App&)) {
+    const std::size_t before = app.get_subcommands({}).size();
+    cli::Run run = make(app);
+    commands.emplace_back(app.get_subcommands({})[before], std::move(run));
+  };
+  add(cli::add_info);
+  add(cli::add_devices);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);   // --help, --version
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitBadInput;
+  }
+  if (verbose) log::set_level(log::Level::Debug);
+  if (quiet) {
+    log::set_level(log::Level::Quiet);
+    Progress::set_enabled(false);
+  }
+
+  try {
+    for (auto& [sub, run] : commands)
+      if (sub->parsed()) return run();
+    return kExitBadInput;
+  } catch (const InputError& e) {
+    std::cerr << "pneumo: error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "pneumo: error: out of memory\n";
+    return kExitFailure;
+  } catch (const std::exception& e) {
+    std::cerr << "pneumo: failed: " << e.what() << "\n";
+    return kExitFailure;
+  }
+}

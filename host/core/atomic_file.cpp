@@ -1,0 +1,60 @@
+#include "core/atomic_file.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "core/error.h"
+
+namespace fs = std::filesystem;
+
+namespace pneumo {
+
+AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
+  static std::atomic<unsigned> counter{0};
+  const fs::path t(target_);
+  // ".<name>.tmp<pid>_<n>.<name>": hidden, unique per process and call, and still ending in the
+  // target's own extensions.
+  const std::string name = t.filename().string();
+  const std::string tmp_name =
+      "." + name + ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + "." + name;
+  temp_ = (t.parent_path() / tmp_name).string();
+}
+
+AtomicFile::~AtomicFile() {
+  if (!committed_) std::remove(temp_.c_str());
+}
+
+void AtomicFile::commit() {
+  if (std::rename(temp_.c_str(), target_.c_str()) != 0)
+    throw std::runtime_error("cannot rename " + temp_ + " to " + target_ + ": " + std::strerror(errno));
+  committed_ = true;
+}
+
+void check_writable_target(const std::string& path) {
+  fs::path dir = fs::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw file_error(path, "folder " + dir.string() + " does not exist");
+  if (::access(dir.c_str(), W_OK) != 0) throw file_error(path, "folder " + dir.string() + " is not writable");
+}
+
+void write_text_file_atomic(const std::string& path, const std::string& text) {
+  check_writable_target(path);
+  AtomicFile f(path);
+  {
+    std::ofstream os(f.temp_path(), std::ios::binary);
+    os << text;
+    os.flush();
+    if (!os) throw std::runtime_error("cannot write " + f.temp_path() + ": " + std::strerror(errno));
+  }
+  f.commit();
+}
+
+}  // namespace pneumo

@@ -1,0 +1,34 @@
+#pragma once
+// Writes that never leave a file looking complete when they were not: data goes to a temporary
+// name beside the target (same folder, so rename is atomic), and only commit() renames it into
+// place. If the writer throws or is interrupted, the destructor removes the temporary file.
+#include <string>
+
+namespace pneumo {
+
+class AtomicFile {
+ public:
+  explicit AtomicFile(std::string target);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  /// Where to write. Keeps the target's extensions (".nii.gz") so libraries that choose the
+  /// format by name still do the right thing.
+  const std::string& temp_path() const { return temp_; }
+  const std::string& target_path() const { return target_; }
+  /// Renames the temporary file to the target; throws if that fails.
+  void commit();
+
+ private:
+  std::string target_, temp_;
+  bool committed_ = false;
+};
+
+/// Writes `text` to `path` atomically.
+void write_text_file_atomic(const std::string& path, const std::string& text);
+
+/// Throws InputError when the folder that would hold `path` does not exist or is not writable.
+void check_writable_target(const std::string& path);
+
+}  // namespace pneumo

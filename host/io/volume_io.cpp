@@ -1,0 +1,64 @@
+#include "io/volume_io.h"
+
+#include <algorithm>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace pneumo {
+
+namespace {
+bool ends_with(const std::string& s, const std::string& suffix) {
+  if (s.size() < suffix.size()) return false;
+  return std::equal(suffix.rbegin(), suffix.rend(), s.rbegin(),
+                    [](char a, char b) { return std::tolower(a) == std::tolower(b); });
+}
+}  // namespace
+
+VolumeFormat volume_format_from_path(const std::string& path) {
+  if (ends_with(path, ".nii.gz")) return VolumeFormat::NiftiGz;
+  if (ends_with(path, ".nii")) return VolumeFormat::Nifti;
+  if (ends_with(path, ".mha")) return VolumeFormat::MetaImageSingle;
+  if (ends_with(path, ".mhd")) return VolumeFormat::MetaImageSplit;
+  throw file_error(path, "unknown volume format (expected .nii, .nii.gz, .mha or .mhd)");
+}
+
+Volume read_volume(const std::string& path) {
+  switch (volume_format_from_path(path)) {
+    case VolumeFormat::Nifti:
+    case VolumeFormat::NiftiGz: return read_nifti(path);
+    case VolumeFormat::MetaImageSingle:
+    case VolumeFormat::MetaImageSplit: return read_metaimage(path);
+  }
+  throw file_error(path, "unknown volume format");
+}
+
+void write_volume(const Volume& v, const std::string& path, const WriteOptions& opt) {
+  switch (volume_format_from_path(path)) {
+    case VolumeFormat::Nifti:
+    case VolumeFormat::NiftiGz: return write_nifti(v, path);
+    case VolumeFormat::MetaImageSingle:
+    case VolumeFormat::MetaImageSplit: return write_metaimage(v, path, opt.compress_metaimage);
+  }
+}
+
+uint64_t checked_payload_bytes(const std::string& path, const int64_t dims[3], std::size_t bytes_per_voxel) {
+  uint64_t total = bytes_per_voxel;
+  for (int a = 0; a < 3; ++a) {
+    if (dims[a] < 1) {
+      std::ostringstream os;
+      os << "dimension " << a << " is " << dims[a] << " (must be at least 1)";
+      throw file_error(path, os.str());
+    }
+    if (static_cast<uint64_t>(dims[a]) > kMaxVolumeBytes || total * static_cast<uint64_t>(dims[a]) > kMaxVolumeBytes) {
+      std::ostringstream os;
+      os << "dimensions " << dims[0] << " x " << dims[1] << " x " << dims[2] << " promise more than "
+         << (kMaxVolumeBytes >> 30) << " GiB of voxels: refusing an absurd header";
+      throw file_error(path, os.str());
+    }
+    total *= static_cast<uint64_t>(dims[a]);
+  }
+  return total;
+}
+
+}  // namespace pneumo

@@ -1,0 +1,40 @@
+#pragma once
+// Reading and writing volumes: NIfTI-1 (.nii, .nii.gz) and MetaImage (.mha, .mhd + raw), chosen by
+// the file name. Every reader checks a header against the file before allocating what it promises,
+// and reports any problem as an InputError naming the file. Every writer is atomic.
+#include <string>
+
+#include "io/volume.h"
+
+namespace pneumo {
+
+enum class VolumeFormat { Nifti, NiftiGz, MetaImageSingle, MetaImageSplit };
+
+/// The format implied by the file name; throws InputError for an unknown extension.
+VolumeFormat volume_format_from_path(const std::string& path);
+
+/// Reads a volume. Scaled integer data (NIfTI scl_slope/scl_inter other than 1/0) is returned as
+/// float32 with the scaling applied (float64 where float32 would round the source type).
+Volume read_volume(const std::string& path);
+
+struct WriteOptions {
+  bool compress_metaimage = false;   // zlib-compress MetaImage voxel data (NIfTI: by .gz name)
+};
+/// Writes atomically: a failed or interrupted write leaves no file at `path`.
+void write_volume(const Volume& v, const std::string& path, const WriteOptions& opt = {});
+
+// Per-format entry points (used by the dispatchers above and by tests).
+Volume read_nifti(const std::string& path);
+void write_nifti(const Volume& v, const std::string& path);
+Volume read_metaimage(const std::string& path);
+void write_metaimage(const Volume& v, const std::string& path, bool compress);
+
+/// Largest voxel payload pneumo agrees to read (bytes): a header promising more is refused
+/// before anything is allocated. 32 GiB: larger than any clinical CT, smaller than absurd.
+constexpr uint64_t kMaxVolumeBytes = 32ull << 30;
+
+/// Checks dims from a header (each ≥ 1, product × voxel bytes ≤ kMaxVolumeBytes) and returns
+/// the payload size in bytes; throws InputError naming `path` otherwise. Overflow-safe.
+uint64_t checked_payload_bytes(const std::string& path, const int64_t dims[3], std::size_t bytes_per_voxel);
+
+}  // namespace pneumo

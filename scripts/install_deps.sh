@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Installs every build and run dependency of pneumo from Debian 12 packages.
+# Idempotent and non-interactive; run as root (or with sudo available).
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake ninja-build pkg-config git ca-certificates
+  # OpenCL: PoCL on the CPU, the ICD loader, C and C++ headers, clinfo to look
+  pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
+  # maths
+  libeigen3-dev
+  # offscreen OpenGL: EGL (primary), OSMesa (fallback), GL headers
+  libegl-dev libgl-dev libopengl-dev libgles-dev libosmesa6-dev libegl-mesa0 mesa-utils
+  # image output
+  libstb-dev
+  # volume I/O
+  libnifti2-dev zlib1g-dev
+  # CLI and scenes
+  libcli11-dev nlohmann-json3-dev
+  # tests and benchmarks
+  libgtest-dev googletest libbenchmark-dev
+)
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install_deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install_deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
