@@ -2,6 +2,7 @@
 // every problem gets a specific message and nothing the header promises is allocated before it is
 // checked against the file; niftilib then converts the header (quaternions, sform) and writes.
 #include <nifti2_io.h>
+#include <zlib.h>
 
 #include <sys/stat.h>
 
@@ -30,10 +31,52 @@ void quiet_niftilib() {
   std::call_once(once, [] { nifti_set_debug_level(0); });
 }
 
-struct ZnzCloser {
-  void operator()(znzFile f) const { if (f) Xznzclose(&f); }
+// zlib's gz reader serves both .nii (read transparently) and .nii.gz, and, unlike niftilib's znz
+// layer, reports a stream that ends early or fails its checksum.
+struct GzCloser {
+  void operator()(gzFile f) const { if (f) gzclose_r(f); }
 };
-using ZnzPtr = std::unique_ptr<std::remove_pointer_t<znzFile>, ZnzCloser>;
+using GzPtr = std::unique_ptr<gzFile_s, GzCloser>;
+
+GzPtr open_for_reading(const std::string& path) {
+  GzPtr f(gzopen(path.c_str(), "rb"));
+  if (!f) throw file_error(path, "cannot open: " + std::string(std::strerror(errno)));
+  return f;
+}
+
+std::string gz_problem(gzFile f) {
+  int code = Z_OK;
+  const char* msg = gzerror(f, &code);
+  return code == Z_OK ? "unexpected end of file" : std::string(msg ? msg : "zlib error");
+}
+
+/// Reads up to n bytes; returns how many were read, or throws on a corrupt stream.
+uint64_t read_bytes(const std::string& path, gzFile f, void* dst, uint64_t n) {
+  constexpr uint64_t kChunk = 256ull << 20;   // gzread takes an unsigned count
+  uint64_t done = 0;
+  char* out = static_cast<char*>(dst);
+  while (done < n) {
+    const unsigned want = static_cast<unsigned>(std::min(kChunk, n - done));
+    const int got = gzread(f, out + done, want);
+    if (got < 0) throw file_error(path, "corrupt compressed data: " + gz_problem(f));
+    done += static_cast<uint64_t>(got);
+    if (static_cast<unsigned>(got) < want) break;
+  }
+  return done;
+}
+
+/// A .nii.gz must end where its gzip stream says (length and CRC checked): reading past the
+/// voxels to the end makes zlib verify both.
+void check_clean_end(const std::string& path, GzPtr f) {
+  char sink[1 << 16];
+  int got;
+  while ((got = gzread(f.get(), sink, sizeof sink)) > 0) {}
+  if (got < 0) throw file_error(path, "corrupt compressed data: " + gz_problem(f.get()));
+  int code = Z_OK;
+  gzerror(f.get(), &code);
+  const int closed = gzclose_r(f.release());
+  if (code != Z_OK || closed != Z_OK) throw file_error(path, "truncated compressed data (the gzip stream ends early)");
+}
 
 struct NimDeleter {
   void operator()(nifti_image* n) const {
@@ -84,10 +127,9 @@ int nifti_datatype_of(VoxelType t) {
 
 /// Reads and checks the raw header; returns it in file byte order plus whether it must be swapped.
 nifti_1_header read_checked_header(const std::string& path, bool* swapped) {
-  ZnzPtr f(znzopen(path.c_str(), "rb", is_gz(path) ? 1 : 0));
-  if (!f) throw file_error(path, "cannot open: " + std::string(std::strerror(errno)));
+  GzPtr f = open_for_reading(path);
   nifti_1_header raw{};
-  const size_t got = znzread(&raw, 1, sizeof raw, f.get());
+  const uint64_t got = read_bytes(path, f.get(), &raw, sizeof raw);
   if (got != sizeof raw)
     throw file_error(path, "file too short for a NIfTI-1 header (" + std::to_string(got) + " of 348 bytes)");
 
@@ -163,24 +205,16 @@ Geometry geometry_from_nim(const std::string& path, const nifti_image& nim) {
 }
 
 void read_payload(const std::string& path, uint64_t offset, uint64_t payload, void* dst) {
-  ZnzPtr f(znzopen(path.c_str(), "rb", is_gz(path) ? 1 : 0));
-  if (!f) throw file_error(path, "cannot open: " + std::string(std::strerror(errno)));
-  if (znzseek(f.get(), static_cast<long>(offset), SEEK_SET) < 0)  // gzseek returns the offset, fseek 0
+  GzPtr f = open_for_reading(path);
+  if (gzseek(f.get(), static_cast<z_off_t>(offset), SEEK_SET) < 0)
     throw file_error(path, "truncated: no voxel data at offset " + std::to_string(offset));
-  // Read in chunks: zlib's gzread takes an unsigned count, and a short chunk pinpoints truncation.
-  constexpr uint64_t kChunk = 256ull << 20;
-  uint64_t done = 0;
-  char* out = static_cast<char*>(dst);
-  while (done < payload) {
-    const size_t want = static_cast<size_t>(std::min(kChunk, payload - done));
-    const size_t got = znzread(out + done, 1, want, f.get());
-    done += got;
-    if (got != want) {
-      std::ostringstream os;
-      os << "truncated or corrupt voxel data: header promises " << payload << " bytes, file holds " << done;
-      throw file_error(path, os.str());
-    }
+  const uint64_t got = read_bytes(path, f.get(), dst, payload);
+  if (got != payload) {
+    std::ostringstream os;
+    os << "truncated or corrupt voxel data: header promises " << payload << " bytes, file holds " << got;
+    throw file_error(path, os.str());
   }
+  if (is_gz(path)) check_clean_end(path, std::move(f));
 }
 
 template <class T>

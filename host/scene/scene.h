@@ -1,0 +1,260 @@
+#pragma once
+// A scene: one case, everything a run needs besides the command itself (inputs, how labels map to
+// roles, mesh, material, load, solver, device, views, outputs).
+//
+// The keys, their defaults, their ranges and their documentation come from one table
+// (scene_params.cpp); docs/scene_reference.md is generated from it. The defaults live here, in
+// the member initialisers, so that a default-constructed struct is always the documented default;
+// the table reads them from there. Sections of method.md are cited as "§n".
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/geometry.h"
+
+namespace pneumo {
+
+// ---- named values ------------------------------------------------------------------------------
+
+/// What a voxel is in the simulation (§2).
+enum class Role : uint8_t { Other = 0, Wall = 1, Viscera = 2, Fixed = 3 };
+enum class RoleSource : uint8_t { Labels, Auto };
+enum class MeshModel : uint8_t { WallViscera, Wall };
+enum class SpringModel : uint8_t { Nonlinear, Linear };
+enum class RampShape : uint8_t { Smooth, Linear };
+enum class SolverMethod : uint8_t { Static, Explicit, Newmark, Kitasaka2004 };
+enum class OnInverted : uint8_t { Continue, Stop };
+enum class Lens : uint8_t { Pinhole, Fisheye };
+enum class RenderPreset : uint8_t { Laparoscopic, CtSoftTissue, CtMuscle, CtAaa, CtAir };
+
+/// How each enum's values are written in scene files, indexed by the value: the one place these
+/// names are spelled (the parser, the reference and enum_name() all read them from here).
+template <class E> struct EnumNames;
+template <> struct EnumNames<Role> {
+  static constexpr std::array<const char*, 4> names{"other", "wall", "viscera", "fixed"};
+};
+template <> struct EnumNames<RoleSource> {
+  static constexpr std::array<const char*, 2> names{"labels", "auto"};
+};
+template <> struct EnumNames<MeshModel> {
+  static constexpr std::array<const char*, 2> names{"wall_viscera", "wall"};
+};
+template <> struct EnumNames<SpringModel> {
+  static constexpr std::array<const char*, 2> names{"nonlinear", "linear"};
+};
+template <> struct EnumNames<RampShape> {
+  static constexpr std::array<const char*, 2> names{"smooth", "linear"};
+};
+template <> struct EnumNames<SolverMethod> {
+  static constexpr std::array<const char*, 4> names{"static", "explicit", "newmark", "kitasaka2004"};
+};
+template <> struct EnumNames<OnInverted> {
+  static constexpr std::array<const char*, 2> names{"continue", "stop"};
+};
+template <> struct EnumNames<Lens> {
+  static constexpr std::array<const char*, 2> names{"pinhole", "fisheye"};
+};
+template <> struct EnumNames<RenderPreset> {
+  static constexpr std::array<const char*, 5> names{"laparoscopic", "ct-soft-tissue", "ct-muscle",
+                                                    "ct-aaa", "ct-air"};
+};
+
+/// The scene-file name of an enum value ("kitasaka2004", "ct-muscle", ...).
+template <class E> const char* enum_name(E e) {
+  return EnumNames<E>::names[static_cast<std::size_t>(e)];
+}
+inline const char* role_name(Role r) { return enum_name(r); }
+
+// ---- sections ----------------------------------------------------------------------------------
+
+struct SceneInputs {
+  std::string ct;       // "" = not given; see Scene::require_ct()
+  std::string labels;   // "" = not given
+};
+
+struct SceneRoles {
+  RoleSource source = RoleSource::Labels;
+  std::vector<int> wall_labels, viscera_labels, fixed_labels, other_labels;
+  Role unlisted_label_role = Role::Other;
+  // Automatic extraction (§2, option). Limits: a single body (largest component), bone by HU only
+  // (contrast-filled vessels above the threshold become fixed too), wall thickness uniform.
+  double auto_body_threshold_hu = -500.0;  // air/lung < -500 < fat (about -100)
+  double auto_bone_threshold_hu = 250.0;   // above soft tissue and enhanced vessels in most scans
+  double auto_wall_thickness_mm = 30.0;    // skin + fat + muscle of an adult abdomen
+  double auto_wall_max_angle_deg = 100.0;  // anterior (0) and lateral (90) sides; the back is not
+  bool auto_use_labels = true;
+  // Air added around the CT so the wall has room to rise (a 12 mmHg abdomen rises 30-60 mm).
+  double pad_anterior_mm = 0.0, pad_lateral_mm = 0.0, pad_superior_mm = 0.0, pad_inferior_mm = 0.0;
+};
+
+struct SceneMesh {
+  int cube_voxels = 8;  // L, Nimura's value (§4 defaults)
+  MeshModel model = MeshModel::WallViscera;
+  std::optional<Vec3> roi_min_mm, roi_max_mm;  // both or neither
+};
+
+/// Young's modulus for one label id, overriding the role's value.
+struct LabelYoung {
+  int label = 0;
+  double young_kpa = 0.0;
+};
+
+struct SceneMaterial {
+  double density_kg_m3 = 1096.0;  // Nimura (§4)
+  double young_kpa = 60.0;        // Nimura (§4)
+  std::optional<double> wall_young_kpa, viscera_young_kpa;
+  std::vector<LabelYoung> label_young_kpa;
+  double damping_ratio = 0.4;     // ζ, Nimura (§4)
+  double spring_scale = 1.0;      // as published; 0.925 matches the lattice to E (§4)
+  SpringModel spring_model = SpringModel::Nonlinear;  // rotation-invariant (§5)
+  std::optional<double> volume_stiffness_kpa;          // unset: see effective_volume_stiffness_kpa()
+  bool gravity = false;           // the CT already shows the body under gravity (§5)
+};
+
+struct SceneLoad {
+  double pressure_mmhg = 12.0;    // the usual clinical pressure; Song et al. measured at 12 (§4)
+  // §6: a ramp over 2-3 periods of the slowest mode keeps overshoot within a few percent. The
+  // slowest mode of an adult abdominal wall (a clamped plate ~300 mm across, 30 mm thick,
+  // E = 60 kPa, ρ = 1096 kg/m³) is near 5 Hz, a 0.2 s period: 500 ms is 2.5 periods.
+  double ramp_ms = 500.0;
+  RampShape ramp_shape = RampShape::Smooth;
+  std::vector<double> pressure_curve_mmhg;  // empty = a single pressure
+};
+
+struct SceneSolver {
+  SolverMethod method = SolverMethod::Static;
+  double dt_ms = 0.0;                    // 0 = dt_safety × the stability bound (§6)
+  double dt_safety = 0.5;
+  int64_t max_steps = 100000;
+  double residual_tolerance = 1e-3;      // max |net force| / max |pressure force|
+  double velocity_tolerance_mm_s = 0.5;
+  int hold_steps = 50;
+  double newmark_beta = 0.25;            // Nimura §2.3.4
+  double newmark_gamma = 0.5;            // Nimura's δ
+  double newmark_inner_tolerance = 1e-6; // relative change of the accelerations
+  int newmark_max_inner = 50;
+  double kitasaka_step = 0.3;            // Δs, Kitasaka §2.4
+  double kitasaka_tolerance_mm = 1.0;    // β of Kitasaka's Eq. 3: Σ|ΔR| over all nodes
+  OnInverted on_inverted = OnInverted::Continue;
+  int64_t checkpoint_every_steps = 0;    // 0 = off
+};
+
+/// Optics shared by cameras, ports and paths (§8).
+struct Optics {
+  Vec3 up = Vec3(0.0, 0.0, 1.0);  // superior (RAS+ world)
+  double fov_deg = 70.0;
+  Lens lens = Lens::Pinhole;
+  double oblique_deg = 0.0;
+  double roll_deg = 0.0;
+  double near_mm = 1.0;
+};
+
+struct Camera {
+  std::string name;
+  Vec3 position_mm = Vec3::Zero();
+  Vec3 look_at_mm = Vec3::Zero();
+  Optics optics;
+};
+
+/// A trocar port on the skin, carried through the deformation, aimed at a point or an organ.
+struct Port {
+  std::string name;
+  Vec3 skin_point_mm = Vec3::Zero();
+  std::optional<Vec3> target_mm;   // exactly one of target_mm, target_label
+  std::optional<int> target_label;
+  double insertion_mm = 40.0;      // tip beyond the skin point, along the port axis
+  Optics optics;
+};
+
+struct Keyframe {
+  Vec3 position_mm = Vec3::Zero();
+  Vec3 look_at_mm = Vec3::Zero();
+};
+
+struct CameraPath {
+  std::string name;
+  int frames = 60;
+  std::vector<Keyframe> keyframes;  // at least 2
+  Optics optics;
+};
+
+struct SceneRender {
+  int width = 640, height = 480;
+  RenderPreset preset = RenderPreset::Laparoscopic;
+  double step_fraction = 0.5;     // §8: step ≤ half the smallest spacing
+  bool jitter = false;            // off: images are reproducible
+  bool show_labels = true;
+  double label_opacity = 0.5;
+  double light_falloff_mm = 100.0;  // d0 of the headlight's 1/(1+(d/d0)²) (§8)
+  std::vector<Camera> cameras;
+  std::vector<Port> ports;
+  std::vector<CameraPath> paths;
+};
+
+struct SceneOutput {
+  std::string folder;             // "" = the command line decides
+  bool write_meshes = false;
+  bool write_deformed_ct = true;
+  bool write_deformed_labels = true;
+  bool write_slices = true;
+  bool write_depth = false;
+  int64_t timelapse_every_steps = 0;  // 0 = off
+};
+
+// ---- the scene ---------------------------------------------------------------------------------
+
+struct Scene {
+  int schema_version = 1;
+  std::string name, description;
+  SceneInputs inputs;
+  SceneRoles roles;
+  SceneMesh mesh;
+  SceneMaterial material;
+  SceneLoad load;
+  SceneSolver solver;
+  std::string device = "cpu";     // "cpu", "opencl" or "opencl:P:D"
+  SceneRender render;
+  SceneOutput output;
+
+  std::string path;    // the scene file as given ("" when built in code)
+  std::string folder;  // absolute folder relative paths were resolved against
+
+  /// The full resolved scene, defaults included, every key present (unset ones as null): written
+  /// next to outputs, and parse_scene() of it gives this scene back.
+  nlohmann::json echo() const;
+
+  /// inputs.ct; throws InputError naming the scene when it is not given.
+  const std::string& require_ct() const;
+
+  /// Role of every label id 0..65535 (index = id): the role lists, else unlisted_label_role.
+  std::vector<Role> label_roles() const;
+
+  /// Young's modulus of a tetrahedron (kPa): label_young_kpa for its label, else the role's
+  /// override (wall_young_kpa, viscera_young_kpa), else young_kpa.
+  double young_kpa_for(Role role, int label) const;
+
+  /// Kitasaka's k_v (kPa): volume_stiffness_kpa when set; unset: young_kpa for kitasaka2004
+  /// (the 2004 scheme needs it: its springs alone let tetrahedra collapse), 0 for the others.
+  double effective_volume_stiffness_kpa() const;
+};
+
+/// Reads a scene file. InputError (one line, naming the file) on any problem: missing file,
+/// invalid JSON (with line and column), unknown key, wrong type, value out of range.
+Scene load_scene(const std::string& path);
+
+/// Reads a scene from parsed JSON; origin_path names it in messages and its folder resolves
+/// relative paths ("" = the current folder).
+Scene parse_scene(const nlohmann::json& j, const std::string& origin_path);
+
+/// Every key at its default.
+Scene default_scene();
+
+/// docs/scene_reference.md: one Markdown table per section, generated from the parameter table.
+std::string scene_reference_markdown();
+
+}  // namespace pneumo

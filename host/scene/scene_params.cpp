@@ -1,0 +1,325 @@
+// THE parameter table: every scene key, its unit, what it allows and what it means. The parser,
+// the echo, the messages and docs/scene_reference.md are all made from these tables; the
+// defaults are the member initialisers in scene.h (see the comments there for their sources).
+// §n = a section of design/method.md.
+#include <cctype>
+#include <string>
+
+#include "scene/param_table.h"
+
+namespace pneumo::scene_detail {
+namespace {
+
+// ---- rules the ranges cannot say ---------------------------------------------------------------
+
+bool is_device(const json& v) {
+  // "cpu", "opencl", "opencl:P:D" with P, D non-negative integers.
+  const std::string s = v.get<std::string>();
+  if (s == "cpu" || s == "opencl") return true;
+  const std::string prefix = "opencl:";
+  if (s.compare(0, prefix.size(), prefix) != 0) return false;
+  const std::string rest = s.substr(prefix.size());
+  const std::size_t colon = rest.find(':');
+  const auto digits = [](const std::string& t) {
+    if (t.empty() || t.size() > 4) return false;
+    for (char ch : t)
+      if (!std::isdigit(static_cast<unsigned char>(ch))) return false;
+    return true;
+  };
+  return colon != std::string::npos && digits(rest.substr(0, colon)) && digits(rest.substr(colon + 1));
+}
+
+// View names become file names: keep them portable.
+bool is_view_name(const json& v) {
+  const std::string s = v.get<std::string>();
+  if (s.empty() || s.size() > 64 || s[0] == '.') return false;
+  for (char ch : s)
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '_' && ch != '-' && ch != '.') return false;
+  return true;
+}
+
+bool is_non_decreasing(const json& v) {
+  for (std::size_t i = 1; i < v.size(); ++i)
+    if (v[i].get<double>() < v[i - 1].get<double>()) return false;
+  return true;
+}
+
+bool is_nonzero_vec(const json& v) {
+  return v[0].get<double>() != 0.0 || v[1].get<double>() != 0.0 || v[2].get<double>() != 0.0;
+}
+
+constexpr double kMaxLabel = 65535;  // label maps are read as up to 16-bit ids
+constexpr double kMaxKPa = 1e6;      // 1 GPa: above any soft tissue by far, below overflow worries
+
+// ---- sections ----------------------------------------------------------------------------------
+
+const Table<SceneInputs>& inputs_table() {
+  static const Table<SceneInputs> t{
+      {"ct", &SceneInputs::ct, "", file_path(),
+       "CT volume (.nii, .nii.gz, .mhd). Unset is accepted here; commands that need a CT say so."},
+      {"labels", &SceneInputs::labels, "", file_path(),
+       "Label map on the CT's voxel grid (integer ids): roles and organ colours."},
+  };
+  return t;
+}
+
+const Table<SceneRoles>& roles_table() {
+  const Constraint ids = in(0, kMaxLabel);
+  const Constraint pad = in(0, 500);
+  static const Table<SceneRoles> t{
+      {"source", &SceneRoles::source, "", any(),
+       "Where roles come from (§2): \"labels\" = the role lists below; \"auto\" = extracted from the CT's HU."},
+      {"wall_labels", &SceneRoles::wall_labels, "", ids,
+       "Label ids of the abdominal wall (skin, fat, muscle). A label id may be in one list only."},
+      {"viscera_labels", &SceneRoles::viscera_labels, "", ids,
+       "Label ids of organs and everything inside the peritoneum that moves."},
+      {"fixed_labels", &SceneRoles::fixed_labels, "", ids, "Label ids that do not move: bone, back, table."},
+      {"other_labels", &SceneRoles::other_labels, "", ids, "Label ids left out of the simulation."},
+      {"unlisted_label_role", &SceneRoles::unlisted_label_role, "", any(),
+       "Role of label ids in none of the lists (label 0, background, included unless listed)."},
+      {"auto_body_threshold_hu", &SceneRoles::auto_body_threshold_hu, "HU", in(-1024, 3071),
+       "auto: voxels above this are body (air and lung below); its largest connected part is kept."},
+      {"auto_bone_threshold_hu", &SceneRoles::auto_bone_threshold_hu, "HU", in(-1024, 3071),
+       "auto: body voxels above this are fixed (bone; contrast-filled vessels above it too)."},
+      {"auto_wall_thickness_mm", &SceneRoles::auto_wall_thickness_mm, "mm", above(0, 200),
+       "auto: wall = body voxels within this distance of the skin, on the sides given by auto_wall_max_angle_deg."},
+      {"auto_wall_max_angle_deg", &SceneRoles::auto_wall_max_angle_deg, "deg", in(0, 180),
+       "auto: the shell is wall where the skin faces within this angle of anterior (90 = lateral); "
+       "the rest of the shell (the back, on the table) is fixed, the body inside it viscera."},
+      {"auto_use_labels", &SceneRoles::auto_use_labels, "", any(),
+       "auto with a label map: voxels whose label is in a role list keep that role; HU rules fill in the rest."},
+      {"pad_anterior_mm", &SceneRoles::pad_anterior_mm, "mm", pad,
+       "Air added in front of the CT so the wall has room to rise (a real CT cropped at the skin needs >= 60)."},
+      {"pad_lateral_mm", &SceneRoles::pad_lateral_mm, "mm", pad,
+       "Air added on the left and on the right (>= 60 for a CT cropped at the skin)."},
+      {"pad_superior_mm", &SceneRoles::pad_superior_mm, "mm", pad, "Air added above the CT (head side)."},
+      {"pad_inferior_mm", &SceneRoles::pad_inferior_mm, "mm", pad, "Air added below the CT (feet side)."},
+  };
+  return t;
+}
+
+const Table<SceneMesh>& mesh_table() {
+  static const Table<SceneMesh> t{
+      {"cube_voxels", &SceneMesh::cube_voxels, "voxels", in(1, 64),
+       "L: each mesh cube covers L×L×L voxels, split into 5 tetrahedra (§3; Nimura: 8)."},
+      {"model", &SceneMesh::model, "", any(),
+       "\"wall_viscera\": wall and viscera are two meshes, the gas opens between them (§3); "
+       "\"wall\": the wall alone, pressure on its inner surface."},
+      {"roi_min_mm", &SceneMesh::roi_min_mm, "mm", any(),
+       "Lower corner (world RAS+) of the box meshed; with roi_max_mm, both or neither. Unset: the whole volume."},
+      {"roi_max_mm", &SceneMesh::roi_max_mm, "mm", any(), "Upper corner of the box meshed; each coordinate > roi_min_mm's."},
+  };
+  return t;
+}
+
+const Table<LabelYoung>& label_young_table() {
+  static const Table<LabelYoung> t{
+      {"label", &LabelYoung::label, "", in(0, kMaxLabel).req(), "Label id."},
+      {"young_kpa", &LabelYoung::young_kpa, "kPa", above(0, kMaxKPa).req(), "Young's modulus of tetrahedra of this label."},
+  };
+  return t;
+}
+
+const Table<SceneMaterial>& material_table() {
+  static const Table<SceneMaterial> t{
+      {"density_kg_m3", &SceneMaterial::density_kg_m3, "kg/m³", in(100, 5000),
+       "ρ: node mass = ρ × a quarter of each adjacent tetrahedron's volume (§4; Nimura 1096)."},
+      {"young_kpa", &SceneMaterial::young_kpa, "kPa", above(0, kMaxKPa),
+       "E of every tetrahedron unless overridden (§4; Nimura 60; measured wall 22.5-42.5)."},
+      {"wall_young_kpa", &SceneMaterial::wall_young_kpa, "kPa", above(0, kMaxKPa),
+       "E of wall tetrahedra; unset = young_kpa (Bano: 24)."},
+      {"viscera_young_kpa", &SceneMaterial::viscera_young_kpa, "kPa", above(0, kMaxKPa),
+       "E of viscera tetrahedra; unset = young_kpa (Bano: 15)."},
+      {"label_young_kpa", &SceneMaterial::label_young_kpa, label_young_table(), any(),
+       "E per label id, over the role's value: [{\"label\": 5, \"young_kpa\": 3}]."},
+      {"damping_ratio", &SceneMaterial::damping_ratio, "", in(0, 10),
+       "ζ: each spring's damper c = 2ζ√(m k) (§4; Nimura 0.4)."},
+      {"spring_scale", &SceneMaterial::spring_scale, "", above(0, 10),
+       "Multiplies every spring stiffness; 0.925 makes the lattice's isotropic modulus equal E (§4)."},
+      {"spring_model", &SceneMaterial::spring_model, "", any(),
+       "\"nonlinear\": rotation-invariant springs (§5); \"linear\": Nimura's Eq. 1 as printed."},
+      {"volume_stiffness_kpa", &SceneMaterial::volume_stiffness_kpa, "kPa", at_least(0),
+       "k_v of Kitasaka's volume-preserving force (§5). Unset: young_kpa for kitasaka2004, 0 (off) for the "
+       "other solvers."},
+      {"gravity", &SceneMaterial::gravity, "", any(),
+       "Apply gravity (9.81 m/s², towards posterior: supine). The CT already shows the body under gravity (§5)."},
+  };
+  return t;
+}
+
+const Table<SceneLoad>& load_table() {
+  static const Table<SceneLoad> t{
+      {"pressure_mmhg", &SceneLoad::pressure_mmhg, "mmHg", in(0, 100),
+       "CO2 pressure on the cavity surfaces (§5). 12 is usual in surgery (Nimura used 10)."},
+      {"ramp_ms", &SceneLoad::ramp_ms, "ms", in(0, 600000),
+       "Time to ramp the pressure up (§6); 0 = all at once (overshoots). 500 ≈ 2.5 periods of an adult "
+       "wall's slowest mode. Dynamic solvers only."},
+      {"ramp_shape", &SceneLoad::ramp_shape, "", any(),
+       "\"smooth\": (1 - cos πτ)/2; \"linear\": τ (§6)."},
+      {"pressure_curve_mmhg", &SceneLoad::pressure_curve_mmhg, "mmHg",
+       in(0, 100).items(0, 100).rule("non-decreasing", is_non_decreasing),
+       "Pressures for a pressure-volume curve, each run to equilibrium from the previous one (§9). "
+       "Empty: pressure_mmhg only."},
+  };
+  return t;
+}
+
+const Table<SceneSolver>& solver_table() {
+  static const Table<SceneSolver> t{
+      {"method", &SceneSolver::method, "", any(),
+       "\"static\": fast equilibrium; \"explicit\": symplectic Euler; \"newmark\": Nimura's Newmark-β; "
+       "\"kitasaka2004\": Kitasaka's quasi-static scheme (§6)."},
+      {"dt_ms", &SceneSolver::dt_ms, "ms", in(0, 1000),
+       "Time step of explicit and newmark; 0 = dt_safety × the stability bound (§6)."},
+      {"dt_safety", &SceneSolver::dt_safety, "", above(0, 1), "Fraction of the stability bound used when dt_ms = 0."},
+      {"max_steps", &SceneSolver::max_steps, "", in(1, 1e9), "Stop (reported as the step limit) after this many steps."},
+      {"residual_tolerance", &SceneSolver::residual_tolerance, "", above(0, 1),
+       "Converged when the largest net node force is below this fraction of the largest pressure force (§6)."},
+      {"velocity_tolerance_mm_s", &SceneSolver::velocity_tolerance_mm_s, "mm/s", above(0, 1e6),
+       "Dynamic solvers: converged also needs every node slower than this (§6)."},
+      {"hold_steps", &SceneSolver::hold_steps, "", in(1, 1000000),
+       "Convergence must hold this many consecutive steps, after the ramp (§6)."},
+      {"newmark_beta", &SceneSolver::newmark_beta, "", in(0, 0.5), "β of Newmark (§6; Nimura 1/4)."},
+      {"newmark_gamma", &SceneSolver::newmark_gamma, "", in(0.5, 1), "γ of Newmark, Nimura's δ (§6; Nimura 1/2)."},
+      {"newmark_inner_tolerance", &SceneSolver::newmark_inner_tolerance, "", above(0, 1),
+       "Newmark's inner loop stops when the accelerations change by less than this, relative (§6)."},
+      {"newmark_max_inner", &SceneSolver::newmark_max_inner, "", in(1, 10000),
+       "Inner iterations allowed per step; more is reported as divergence of the inner loop."},
+      {"kitasaka_step", &SceneSolver::kitasaka_step, "", above(0, 2),
+       "Δs of the 2004 scheme, R += Δs F/D (§6; Kitasaka 0.3)."},
+      {"kitasaka_tolerance_mm", &SceneSolver::kitasaka_tolerance_mm, "mm", above(0, 1e9),
+       "β of the 2004 scheme: stop when Σ|ΔR| over all nodes is below it (Kitasaka Eq. 3; scales with node count)."},
+      {"on_inverted", &SceneSolver::on_inverted, "", any(),
+       "When a tetrahedron turns inside out: \"continue\" (counted and reported) or \"stop\"."},
+      {"checkpoint_every_steps", &SceneSolver::checkpoint_every_steps, "", in(0, 1e9),
+       "Save the node state every this many steps, to resume a long run; 0 = never."},
+  };
+  return t;
+}
+
+const Table<Optics>& optics_table() {
+  static const Table<Optics> t{
+      {"up", &Optics::up, "", any().rule("not [0, 0, 0]", is_nonzero_vec),
+       "Direction that appears up in the image (world RAS+; [0, 0, 1] = superior)."},
+      {"fov_deg", &Optics::fov_deg, "deg", above(0, 180),
+       "Field of view across the image (§8: 70); a pinhole lens needs < 180."},
+      {"lens", &Optics::lens, "", any(), "\"pinhole\" or \"fisheye\" (equidistant, up to 180°) (§8)."},
+      {"oblique_deg", &Optics::oblique_deg, "deg", in(0, 90),
+       "Angle between the scope's axis and its view direction (laparoscopes: 0, 30, 45) (§8)."},
+      {"roll_deg", &Optics::roll_deg, "deg", in(-180, 180),
+       "Rotation of the scope about its axis; turns an oblique view around the axis."},
+      {"near_mm", &Optics::near_mm, "mm", in(0, 1000), "Nothing closer than this to the tip is drawn."},
+  };
+  return t;
+}
+
+Constraint view_name() {
+  return required().rule("letters, digits, '_', '-', '.'; 1 to 64; unique across views", is_view_name);
+}
+
+const Table<Camera>& camera_table() {
+  static const Table<Camera> t(
+      {
+          {"name", &Camera::name, "", view_name(), "Names the output images."},
+          {"position_mm", &Camera::position_mm, "mm", required(), "Scope tip (world RAS+)."},
+          {"look_at_mm", &Camera::look_at_mm, "mm", required(), "A point on the scope's axis, ahead of the tip."},
+      },
+      inline_params(&Camera::optics, optics_table()));
+  return t;
+}
+
+const Table<Port>& port_table() {
+  static const Table<Port> t(
+      {
+          {"name", &Port::name, "", view_name(), "Names the output images."},
+          {"skin_point_mm", &Port::skin_point_mm, "mm", required(),
+           "Where the trocar enters, on the CT's skin; carried through the deformation (§8)."},
+          {"target_mm", &Port::target_mm, "mm", any(), "Point the scope aims at; or give target_label."},
+          {"target_label", &Port::target_label, "", in(1, kMaxLabel),
+           "Label id whose centroid (after deformation) the scope aims at; or give target_mm."},
+          {"insertion_mm", &Port::insertion_mm, "mm", in(0, 500),
+           "Scope tip's distance beyond the skin point, along the port axis."},
+      },
+      inline_params(&Port::optics, optics_table()));
+  return t;
+}
+
+const Table<Keyframe>& keyframe_table() {
+  static const Table<Keyframe> t{
+      {"position_mm", &Keyframe::position_mm, "mm", required(), "Scope tip (world RAS+, deformed frame)."},
+      {"look_at_mm", &Keyframe::look_at_mm, "mm", required(), "A point on the scope's axis, ahead of the tip."},
+  };
+  return t;
+}
+
+const Table<CameraPath>& path_table() {
+  static const Table<CameraPath> t(
+      {
+          {"name", &CameraPath::name, "", view_name(), "Names the output frames."},
+          {"frames", &CameraPath::frames, "", in(2, 100000), "Frames rendered along the path."},
+          {"keyframes", &CameraPath::keyframes, keyframe_table(), any().items(2).req(),
+           "Poses the path passes through, interpolated in order."},
+      },
+      inline_params(&CameraPath::optics, optics_table()));
+  return t;
+}
+
+const Table<SceneRender>& render_table() {
+  static const Table<SceneRender> t{
+      {"width", &SceneRender::width, "px", in(16, 8192), "Image width."},
+      {"height", &SceneRender::height, "px", in(16, 8192), "Image height."},
+      {"preset", &SceneRender::preset, "", any(),
+       "Transfer function (§8): \"laparoscopic\" (flesh tones, gas clear) or one of 3D Slicer's CT presets."},
+      {"step_fraction", &SceneRender::step_fraction, "", above(0, 0.5),
+       "Ray step as a fraction of the smallest voxel spacing (§8: at most half)."},
+      {"jitter", &SceneRender::jitter, "", any(), "Offset each ray's start randomly (hides wood-grain bands; images then vary)."},
+      {"show_labels", &SceneRender::show_labels, "", any(),
+       "Blend organ label colours over the CT colour (§8) when a label map is given."},
+      {"label_opacity", &SceneRender::label_opacity, "", in(0, 1), "Opacity of the label colours."},
+      {"light_falloff_mm", &SceneRender::light_falloff_mm, "mm", above(0, 10000),
+       "d0 of the headlight: intensity 1/(1+(d/d0)²) at distance d from the tip (§8)."},
+      {"cameras", &SceneRender::cameras, camera_table(), any().items(0, 256), "Views given by tip and aim."},
+      {"ports", &SceneRender::ports, port_table(), any().items(0, 256),
+       "Views from trocar ports on the skin, aimed at a point or an organ."},
+      {"paths", &SceneRender::paths, path_table(), any().items(0, 64), "Fly-throughs along keyframes."},
+  };
+  return t;
+}
+
+const Table<SceneOutput>& output_table() {
+  static const Table<SceneOutput> t{
+      {"folder", &SceneOutput::folder, "", file_path(), "Where outputs go; unset: the command line decides (--out)."},
+      {"write_meshes", &SceneOutput::write_meshes, "", any(), "Write the rest and deformed meshes (.vtu)."},
+      {"write_deformed_ct", &SceneOutput::write_deformed_ct, "", any(), "Write the warped CT (§7)."},
+      {"write_deformed_labels", &SceneOutput::write_deformed_labels, "", any(),
+       "Write the warped label map (with the cavity label) when a label map is given (§7)."},
+      {"write_slices", &SceneOutput::write_slices, "", any(), "Write before/after slice pairs (axial, coronal, sagittal)."},
+      {"write_depth", &SceneOutput::write_depth, "", any(), "Write a depth map beside each view."},
+      {"timelapse_every_steps", &SceneOutput::timelapse_every_steps, "", in(0, 1e9),
+       "Write the deformed mesh every this many solver steps; 0 = never."},
+  };
+  return t;
+}
+
+}  // namespace
+
+const Table<Scene>& scene_table() {
+  static const Table<Scene> t{
+      {"$schema_version", &Scene::schema_version, "", in(1, 1), "Version of this format; optional."},
+      {"name", &Scene::name, "", any(), "Short name of the case (reports, window titles)."},
+      {"description", &Scene::description, "", any(), "Free text."},
+      {"inputs", &Scene::inputs, inputs_table(), "Input volumes."},
+      {"roles", &Scene::roles, roles_table(), "Which voxels are wall, viscera, fixed or left out (§2)."},
+      {"mesh", &Scene::mesh, mesh_table(), "The tetrahedral meshes (§3)."},
+      {"material", &Scene::material, material_table(), "Mass-spring-damper material (§4, §5)."},
+      {"load", &Scene::load, load_table(), "Insufflation pressure and how it is applied (§5, §6)."},
+      {"solver", &Scene::solver, solver_table(), "How equilibrium is reached (§6)."},
+      {"device", &Scene::device, "", any().rule("\"cpu\", \"opencl\", \"opencl:P:D\" (platform P, device D)", is_device),
+       "Where to compute: the C++ reference or an OpenCL device (`pneumo devices` lists them)."},
+      {"render", &Scene::render, render_table(), "Laparoscope views (§8)."},
+      {"output", &Scene::output, output_table(), "What is written besides the scene echo."},
+  };
+  return t;
+}
+
+}  // namespace pneumo::scene_detail

@@ -1,0 +1,146 @@
+// Scene files → Scene: reading the text (JSON with comments, duplicate keys refused, errors with
+// line and column), then the parameter table, then the cross-key rules.
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "core/error.h"
+#include "scene/param_table.h"
+#include "scene/scene.h"
+
+namespace pneumo {
+namespace {
+
+using scene_detail::json;
+
+// nlohmann keeps the last of two equal keys without a word; in a scene that hides a mistake
+// (two "pressure_mmhg", one of them ignored). This parser callback refuses them, naming the key's
+// path. It tracks where the parser is: one frame per open object or array.
+class DuplicateKeyCheck {
+ public:
+  explicit DuplicateKeyCheck(std::string file) : file_(std::move(file)) {}
+
+  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start: open(false); break;
+      case json::parse_event_t::array_start: open(true); break;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end: frames_.pop_back(); break;
+      case json::parse_event_t::key: {
+        Frame& f = frames_.back();
+        f.key = parsed.get<std::string>();
+        if (!f.keys.insert(f.key).second)
+          throw InputError(file_ + ": " + child_path(f) + " is given twice; each key may appear once");
+        break;
+      }
+      case json::parse_event_t::value:
+        if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool array = false;
+    std::string path, key;
+    long index = -1;
+    std::set<std::string> keys;
+  };
+
+  // A value starts in the current frame: its path is the frame's path plus its key or index.
+  std::string child_path(Frame& f) const {
+    if (f.array) return f.path + "[" + std::to_string(f.index) + "]";
+    return f.path.empty() ? f.key : f.path + "." + f.key;
+  }
+
+  void open(bool array) {
+    Frame f;
+    f.array = array;
+    if (!frames_.empty()) {
+      Frame& parent = frames_.back();
+      if (parent.array) ++parent.index;
+      f.path = child_path(parent);
+    }
+    frames_.push_back(std::move(f));
+  }
+
+  std::string file_;
+  std::vector<Frame> frames_;
+};
+
+// "line L, column C" of a byte offset (1-based, as editors count).
+std::string line_column(const std::string& text, std::size_t byte) {
+  std::size_t line = 1, column = 1;
+  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(column);
+}
+
+// nlohmann's message without its "[json.exception.parse_error.101] parse error at line 3,
+// column 5: " preamble (we say where ourselves, counting the same way).
+std::string parse_problem(const json::exception& e) {
+  std::string what = e.what();
+  const std::size_t bracket = what.find("] ");
+  if (bracket != std::string::npos) what = what.substr(bracket + 2);
+  const std::size_t colon = what.find(": ");
+  if (what.compare(0, 11, "parse error") == 0 && colon != std::string::npos) what = what.substr(colon + 2);
+  return what;
+}
+
+json read_json_file(const std::string& path) {
+  if (std::filesystem::is_directory(path)) throw file_error(path, "is a folder, not a scene file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw file_error(path, std::string("cannot open the scene file (") + std::strerror(errno) + ")");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  try {
+    // Comments (// and /* */) are allowed: scenes are written by hand.
+    return json::parse(text, DuplicateKeyCheck(path), /*allow_exceptions=*/true, /*ignore_comments=*/true);
+  } catch (const json::parse_error& e) {
+    // e.byte is one past the offending character.
+    throw file_error(path, "invalid JSON at " + line_column(text, e.byte > 0 ? e.byte - 1 : 0) + ": " +
+                               parse_problem(e));
+  } catch (const json::out_of_range& e) {
+    // A number too large for a double (1e999): nlohmann reports it as out_of_range, with no position.
+    throw file_error(path, "invalid JSON: " + parse_problem(e));
+  }
+}
+
+}  // namespace
+
+Scene parse_scene(const nlohmann::json& j, const std::string& origin_path) {
+  namespace fs = std::filesystem;
+  scene_detail::ReadContext ctx;
+  ctx.file = origin_path.empty() ? "scene" : origin_path;
+  ctx.folder = (origin_path.empty() ? fs::current_path() : fs::absolute(origin_path).parent_path())
+                   .lexically_normal()
+                   .string();
+  ctx.root = &scene_detail::scene_table();
+
+  Scene s;
+  scene_detail::scene_table().read(s, j, scene_detail::At{&ctx, ""});
+  scene_detail::validate_scene(s, ctx);
+  s.path = origin_path;
+  s.folder = ctx.folder;
+  return s;
+}
+
+Scene load_scene(const std::string& path) { return parse_scene(read_json_file(path), path); }
+
+Scene default_scene() { return Scene{}; }
+
+nlohmann::json Scene::echo() const { return scene_detail::scene_table().write(*this); }
+
+}  // namespace pneumo

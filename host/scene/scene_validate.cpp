@@ -1,0 +1,120 @@
+// Rules that involve more than one key, checked after every key passed its own checks. Messages
+// have the same shape as the table's: file, key path, value, what is wrong.
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "scene/param_table.h"
+
+namespace pneumo::scene_detail {
+namespace {
+
+json vec_json(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
+
+// Each label id has one role: a label in two lists would make the role depend on list order.
+void check_role_lists(const SceneRoles& r, const At& roles) {
+  const std::vector<std::pair<const char*, const std::vector<int>*>> lists{
+      {"wall_labels", &r.wall_labels},
+      {"viscera_labels", &r.viscera_labels},
+      {"fixed_labels", &r.fixed_labels},
+      {"other_labels", &r.other_labels}};
+  std::map<int, const char*> owner;
+  for (const auto& [key, ids] : lists)
+    for (int id : *ids) {
+      const auto [it, fresh] = owner.emplace(id, key);
+      if (!fresh)
+        throw InputError(roles.ctx->file + ": label " + std::to_string(id) + " is in both " +
+                         roles.child(it->second).path + " and " + roles.child(key).path +
+                         "; a label has one role");
+    }
+}
+
+void check_roi(const SceneMesh& m, const At& mesh) {
+  if (m.roi_min_mm.has_value() != m.roi_max_mm.has_value()) {
+    const char* given = m.roi_min_mm ? "roi_min_mm" : "roi_max_mm";
+    const char* other = m.roi_min_mm ? "roi_max_mm" : "roi_min_mm";
+    mesh.child(given).fail("is set but " + mesh.child(other).path + " is not; give both or neither");
+  }
+  if (m.roi_min_mm && !(m.roi_min_mm->array() < m.roi_max_mm->array()).all())
+    mesh.child("roi_max_mm").fail_value(vec_json(*m.roi_max_mm), "must exceed " + mesh.child("roi_min_mm").path +
+                                                                      " = " + show(vec_json(*m.roi_min_mm)) +
+                                                                      " in every coordinate");
+}
+
+void check_label_young(const SceneMaterial& m, const At& material) {
+  std::map<int, std::size_t> first;
+  const At list = material.child("label_young_kpa");
+  for (std::size_t i = 0; i < m.label_young_kpa.size(); ++i) {
+    const int label = m.label_young_kpa[i].label;
+    const auto [it, fresh] = first.emplace(label, i);
+    if (!fresh)
+      list.item(i).child("label").fail_value(label, "is listed twice (also " + list.item(it->second).path + ")");
+  }
+}
+
+// The view direction must exist, and `up` must not lie along it (the image's roll is then undefined).
+void check_pose(const Vec3& position, const Vec3& look_at, const Optics& o, const At& view,
+                const std::string& position_key, const std::string& look_at_key, const At& optics) {
+  const Vec3 axis = look_at - position;
+  if (axis.norm() < 1e-9)
+    view.child(look_at_key).fail_value(vec_json(look_at), "equals " + position_key + "; the scope needs a direction");
+  if (axis.normalized().cross(o.up.normalized()).norm() < 1e-6)
+    optics.child("up").fail_value(vec_json(o.up), "is parallel to the scope's axis (" + look_at_key + " - " +
+                                                      position_key + "); choose another up");
+}
+
+void check_lens(const Optics& o, const At& optics) {
+  if (o.lens == Lens::Pinhole && o.fov_deg >= 180.0)
+    optics.child("fov_deg").fail_value(o.fov_deg, "is not allowed with lens \"pinhole\"; allowed: < 180 "
+                                                  "(a fisheye allows 180)");
+}
+
+void check_views(const SceneRender& r, const At& render) {
+  std::map<std::string, std::string> names;  // name → path of the view that has it
+  const auto claim = [&](const std::string& name, const At& view) {
+    const auto [it, fresh] = names.emplace(name, view.path);
+    if (!fresh)
+      view.child("name").fail_value(name, "is used twice (also " + it->second + "); views name output files");
+  };
+  for (std::size_t i = 0; i < r.cameras.size(); ++i) {
+    const Camera& c = r.cameras[i];
+    const At at = render.child("cameras").item(i);
+    claim(c.name, at);
+    check_lens(c.optics, at);
+    check_pose(c.position_mm, c.look_at_mm, c.optics, at, "position_mm", "look_at_mm", at);
+  }
+  for (std::size_t i = 0; i < r.ports.size(); ++i) {
+    const Port& p = r.ports[i];
+    const At at = render.child("ports").item(i);
+    claim(p.name, at);
+    check_lens(p.optics, at);
+    if (p.target_mm.has_value() == p.target_label.has_value())
+      at.fail(p.target_mm ? "gives both target_mm and target_label; give one"
+                          : "gives neither target_mm nor target_label; give one");
+    if (p.target_mm) check_pose(p.skin_point_mm, *p.target_mm, p.optics, at, "skin_point_mm", "target_mm", at);
+  }
+  for (std::size_t i = 0; i < r.paths.size(); ++i) {
+    const CameraPath& p = r.paths[i];
+    const At at = render.child("paths").item(i);
+    claim(p.name, at);
+    check_lens(p.optics, at);
+    for (std::size_t k = 0; k < p.keyframes.size(); ++k) {
+      const At key = at.child("keyframes").item(k);
+      check_pose(p.keyframes[k].position_mm, p.keyframes[k].look_at_mm, p.optics, key, "position_mm", "look_at_mm", at);
+    }
+  }
+}
+
+}  // namespace
+
+void validate_scene(const Scene& s, const ReadContext& ctx) {
+  const At root{&ctx, ""};
+  check_role_lists(s.roles, root.child("roles"));
+  check_roi(s.mesh, root.child("mesh"));
+  check_label_young(s.material, root.child("material"));
+  check_views(s.render, root.child("render"));
+}
+
+}  // namespace pneumo::scene_detail

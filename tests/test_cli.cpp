@@ -1,0 +1,117 @@
+// The pneumo executable as a user meets it: exit codes (0 success, 1 failure, 2 bad input), one-line
+// errors naming the file and the problem, --help and --version on every subcommand, info --json keys.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "io_test_support.h"
+#include "shared_data.h"
+
+using pneumo::testing_support::ScratchDir;
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+Result run_cli(const std::string& args) {
+  ScratchDir tmp;
+  const std::string out = tmp.file("stdout"), err = tmp.file("stderr");
+  const std::string cmd = std::string(PNEUMO_CLI_PATH) + " " + args + " >" + out + " 2>" + err + " </dev/null";
+  const int status = std::system(cmd.c_str());
+  Result r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+int count_lines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+}  // namespace
+
+TEST(Cli, VersionAndHelp) {
+  auto v = run_cli("--version");
+  EXPECT_EQ(v.code, 0);
+  EXPECT_NE(v.out.find("pneumo " PNEUMO_VERSION), std::string::npos) << v.out;
+  for (const char* sub : {"", "info", "devices", "phantom", "scene"}) {
+    auto h = run_cli(std::string(sub) + " --help");
+    EXPECT_EQ(h.code, 0) << sub;
+    EXPECT_FALSE(h.out.empty()) << sub;
+  }
+}
+
+TEST(Cli, UnknownSubcommandOrOptionIsBadInput) {
+  EXPECT_EQ(run_cli("no-such-command").code, 2);
+  EXPECT_EQ(run_cli("info --no-such-flag x.nii").code, 2);
+  EXPECT_EQ(run_cli("").code, 2);
+}
+
+TEST(Cli, BadFilesGiveOneLineNamingTheFileAndExitTwo) {
+  ScratchDir d;
+  { std::ofstream(d.file("garbage.nii")) << "this is not a NIfTI file at all, just text that goes on"; }
+  { std::ofstream(d.file("empty.mha")); }
+  for (const std::string& f : {d.file("missing.nii.gz"), d.file("garbage.nii"), d.file("empty.mha"), d.file("x.png")}) {
+    auto r = run_cli("info " + f);
+    EXPECT_EQ(r.code, 2) << f << ": " << r.err;
+    EXPECT_EQ(count_lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(f), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
+TEST(Cli, InfoJsonHasTheDocumentedKeys) {
+  PNEUMO_REQUIRE_SHARED_DATA();
+  auto r = run_cli("info --json " + pneumo::testing_support::totalseg_dir() + "/example_ct.nii.gz");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"dims", "spacing_mm", "origin_mm", "direction", "orientation", "datatype", "min", "max"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["orientation"], "RAS");
+  EXPECT_EQ(j["datatype"], "int32");
+  EXPECT_EQ(j["min"], -1207);
+  EXPECT_EQ(j["max"], 3382);
+  EXPECT_EQ(j["kind"], "image");
+}
+
+TEST(Cli, InfoListsLabelIdsAndCounts) {
+  PNEUMO_REQUIRE_SHARED_DATA();
+  auto r = run_cli("info --json " + pneumo::testing_support::totalseg_dir() + "/example_seg_fast_force_split.nii.gz");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["kind"], "label_map");
+  bool liver = false;
+  for (const auto& l : j["labels"])
+    if (l["id"] == 5) {
+      liver = true;
+      EXPECT_EQ(l["voxels"], 41692);
+      EXPECT_NEAR(l["volume_ml"].get<double>(), 1125.7, 0.1);
+    }
+  EXPECT_TRUE(liver);
+}
+
+TEST(Cli, DevicesListsTheReferenceAndOpenCL) {
+  auto r = run_cli("devices --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_GE(j.size(), 1u);
+  EXPECT_EQ(j[0]["spec"], "cpu");
+  for (std::size_t i = 1; i < j.size(); ++i)
+    for (const char* key : {"type", "compute_units", "global_mem_bytes", "fp64"}) EXPECT_TRUE(j[i].contains(key)) << key;
+}

@@ -1,0 +1,509 @@
+// Scenes: the parameter table, the parser's messages, path resolution, the cross-key rules and the
+// generated reference.
+//
+// What is compared: parsed values and echoed JSON exactly (no tolerance: numbers pass through
+// JSON unchanged); error messages by the substrings a user needs (file, key path, value, what is
+// allowed). The round trip and the range tests walk the table itself, so a key added to it is
+// tested without touching this file.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+
+#include "core/error.h"
+#include "scene/param_table.h"
+#include "scene/scene.h"
+
+namespace pneumo {
+namespace {
+
+namespace fs = std::filesystem;
+using scene_detail::json;
+using scene_detail::Kind;
+using scene_detail::ParamInfo;
+using scene_detail::TableDoc;
+
+const char* const kOrigin = "/cases/abdomen/scene.json";  // never opened: parse_scene only names it
+
+// The message of the InputError that parsing `j` throws, or "" when it parses.
+std::string error_of(const json& j, const std::string& origin = kOrigin) {
+  try {
+    parse_scene(j, origin);
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "messages are one line: " << what;
+    return what;
+  }
+  return "";
+}
+
+#define EXPECT_CONTAINS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "pneumo_scene_tests";
+  fs::create_directories(dir);
+  const fs::path p = dir / name;
+  std::ofstream(p, std::ios::binary) << text;
+  return p.string();
+}
+
+// A scene with one item of every array, so that walking it reaches every key of every table.
+json full_scene() {
+  return json::parse(R"({
+    "inputs": {"ct": "ct.nii.gz", "labels": "labels.nii.gz"},
+    "mesh": {"roi_min_mm": [-10, -10, -10], "roi_max_mm": [10, 10, 10]},
+    "material": {"label_young_kpa": [{"label": 3, "young_kpa": 5}]},
+    "render": {
+      "cameras": [{"name": "cam", "position_mm": [0, 0, 0], "look_at_mm": [0, 100, 0]}],
+      "ports": [{"name": "port", "skin_point_mm": [0, 100, 0], "target_mm": [0, 50, 0]}],
+      "paths": [{"name": "fly", "keyframes": [{"position_mm": [0, 0, 0], "look_at_mm": [0, 100, 0]},
+                                              {"position_mm": [0, 10, 0], "look_at_mm": [0, 100, 0]}]}]
+    }
+  })");
+}
+
+// Visits every value key of `table` under `ptr` in `scene` (items of arrays: those present).
+void for_each_key(const TableDoc& table, const json& scene, const json::json_pointer& ptr, const std::string& path,
+                  const std::function<void(const ParamInfo&, const json::json_pointer&, const std::string&)>& f) {
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    const ParamInfo& p = table.info(i);
+    const std::string full = path.empty() ? p.key : path + "." + p.key;
+    if (p.kind == Kind::Section) {
+      for_each_key(*p.sub, scene, ptr / p.key, full, f);
+    } else if (p.kind == Kind::ObjectArray) {
+      const json& items = scene.at(ptr / p.key);
+      for (std::size_t k = 0; k < items.size(); ++k)
+        for_each_key(*p.sub, scene, ptr / p.key / k, full + "[" + std::to_string(k) + "]", f);
+    } else {
+      f(p, ptr / p.key, full);
+    }
+  }
+}
+
+// A valid value for key `p` that differs from `current` (null when there is none, e.g. a key whose
+// only allowed value is its default).
+json other_value(const ParamInfo& p, const json& current, int serial) {
+  const auto ok = [&](const json& v) { return p.c.rule_ok == nullptr || p.c.rule_ok(v); };
+  switch (p.kind) {
+    case Kind::Bool: return !current.get<bool>();
+    case Kind::Int:
+    case Kind::Real: {
+      const double base = current.is_null() ? 1.0 : current.get<double>();
+      const auto& r = p.c.range;
+      std::vector<double> candidates{base + 1, base - 1, r.lo, r.hi};
+      if (p.kind == Kind::Real) candidates.insert(candidates.begin(), {base + 0.125, base - 0.125});
+      if (std::isfinite(r.lo) && std::isfinite(r.hi)) candidates.insert(candidates.begin(), 0.5 * (r.lo + r.hi));
+      for (double x : candidates) {
+        if (p.kind == Kind::Int) x = std::floor(x);
+        if (std::isfinite(x) && r.contains(x) && (current.is_null() || x != base))
+          return p.kind == Kind::Int ? json(static_cast<int64_t>(x)) : json(x);
+      }
+      return nullptr;
+    }
+    case Kind::String:
+      for (const json& v : {json("v" + std::to_string(serial)), json("opencl:1:2")})
+        if (v != current && ok(v)) return v;
+      return nullptr;
+    case Kind::Path: return "sub/file" + std::to_string(serial) + ".nii.gz";
+    case Kind::Enum: {
+      const auto& c = p.choices;
+      const auto at = std::find(c.begin(), c.end(), current.get<std::string>());
+      return c[(at - c.begin() + 1) % c.size()];
+    }
+    case Kind::Vec3: {
+      if (current.is_null()) return json::array({1.0, 2.0, 3.0});
+      json v = current;
+      for (int k = 0; k < 3; ++k) v[k] = v[k].get<double>() + 0.5 * (k + 1);
+      return v;
+    }
+    case Kind::IdList: return json::array({100 + serial});
+    case Kind::RealList: return json::array({5.0, 10.0});
+    default: return nullptr;
+  }
+}
+
+// ---- defaults ----------------------------------------------------------------------------------
+
+TEST(SceneDefaults, MatchMethodAndTable) {
+  const Scene s = default_scene();
+  // method.md §4 (Nimura's values) and the choices written down in scene.h.
+  EXPECT_EQ(s.mesh.cube_voxels, 8);
+  EXPECT_EQ(s.material.density_kg_m3, 1096.0);
+  EXPECT_EQ(s.material.young_kpa, 60.0);
+  EXPECT_EQ(s.material.damping_ratio, 0.4);
+  EXPECT_EQ(s.material.spring_scale, 1.0);
+  EXPECT_EQ(s.material.spring_model, SpringModel::Nonlinear);
+  EXPECT_FALSE(s.material.gravity);
+  EXPECT_EQ(s.load.pressure_mmhg, 12.0);
+  EXPECT_EQ(s.solver.method, SolverMethod::Static);
+  EXPECT_EQ(s.solver.newmark_beta, 0.25);
+  EXPECT_EQ(s.solver.newmark_gamma, 0.5);
+  EXPECT_EQ(s.solver.kitasaka_step, 0.3);
+  EXPECT_EQ(s.device, "cpu");
+  EXPECT_EQ(s.roles.unlisted_label_role, Role::Other);
+  EXPECT_EQ(s.roles.auto_body_threshold_hu, -500.0);
+  EXPECT_EQ(s.roles.auto_bone_threshold_hu, 250.0);
+  EXPECT_LE(s.render.step_fraction, 0.5);
+
+  // An empty scene is the default scene, and the table's defaults are the struct's.
+  EXPECT_EQ(parse_scene(json::object(), kOrigin).echo(), s.echo());
+  EXPECT_EQ(scene_detail::scene_table().defaults(), s.echo());
+  EXPECT_EQ(s.echo().at("$schema_version"), 1);
+}
+
+TEST(SceneDefaults, EveryDefaultIsAllowed) {
+  // Each default passes its own key's checks: the default scene, echoed, reads back.
+  const json echo = default_scene().echo();
+  EXPECT_EQ(error_of(echo), "");
+  EXPECT_EQ(parse_scene(echo, kOrigin).echo(), echo);
+}
+
+// ---- round trip --------------------------------------------------------------------------------
+
+TEST(SceneRoundTrip, FullSceneEchoReadsBack) {
+  const Scene a = parse_scene(full_scene(), kOrigin);
+  const Scene b = parse_scene(a.echo(), "/elsewhere/echo.json");  // paths are absolute by now
+  EXPECT_EQ(b.echo(), a.echo());
+}
+
+TEST(SceneRoundTrip, EveryKeyChangesItsOwnValueOnly) {
+  // For each key: set a non-default value, parse, echo; the echo must hold that value at that key
+  // and nothing else may change. Catches a key bound to the wrong field and a field never written.
+  const json base_json = full_scene();
+  const json base = parse_scene(base_json, kOrigin).echo();
+  int serial = 0, tested = 0;
+  for_each_key(scene_detail::scene_table(), base, json::json_pointer(), "",
+               [&](const ParamInfo& p, const json::json_pointer& ptr, const std::string& path) {
+    const json value = other_value(p, base.at(ptr), ++serial);
+    if (value.is_null()) return;  // $schema_version: its default is its only value
+    json changed = base;
+    changed[ptr] = value;
+    json::json_pointer companion;  // a key that must change with this one
+    if (path == "render.ports[0].target_label") {
+      companion = ptr.parent_pointer() / "target_mm";
+      changed[companion] = nullptr;
+    }
+    SCOPED_TRACE(path + " = " + value.dump());
+    const std::string err = error_of(changed);
+    ASSERT_EQ(err, "");
+    json echo = parse_scene(changed, kOrigin).echo();
+    const json expected = p.kind == Kind::Path ? json("/cases/abdomen/" + value.get<std::string>()) : value;
+    EXPECT_EQ(echo.at(ptr), expected);
+    echo[ptr] = base.at(ptr);
+    if (!companion.empty()) echo[companion] = base.at(companion);
+    EXPECT_EQ(echo, base) << "changing " << path << " changed other keys";
+    ++tested;
+  });
+  EXPECT_GT(tested, 100);
+}
+
+// ---- unknown keys ------------------------------------------------------------------------------
+
+TEST(SceneErrors, UnknownKeyTopLevelSuggestsWhereItBelongs) {
+  const std::string e = error_of({{"presure_mmhg", 12}});
+  EXPECT_CONTAINS(e, kOrigin);
+  EXPECT_CONTAINS(e, "presure_mmhg is an unknown key");
+  EXPECT_CONTAINS(e, "did you mean load.pressure_mmhg?");
+  EXPECT_CONTAINS(error_of({{"lod", json::object()}}), "did you mean load?");
+}
+
+TEST(SceneErrors, UnknownKeyNestedSuggestsClosest) {
+  EXPECT_CONTAINS(error_of({{"load", {{"presure_mmhg", 12}}}}), "load.presure_mmhg is an unknown key; did you mean load.pressure_mmhg?");
+  // A key without its unit suffix is the likeliest slip.
+  EXPECT_CONTAINS(error_of({{"material", {{"young", 30}}}}), "did you mean material.young_kpa?");
+  // Nothing close: the known keys of that object are listed.
+  const std::string e = error_of({{"mesh", {{"zzzzzzzzzz", 1}}}});
+  EXPECT_CONTAINS(e, "mesh.zzzzzzzzzz is an unknown key; known keys in mesh: cube_voxels, model");
+}
+
+TEST(SceneErrors, UnknownKeyInArrayItemCarriesIndex) {
+  json j = full_scene();
+  j["render"]["cameras"].push_back({{"name", "b"}, {"position_mm", {0, 0, 0}}, {"look_at_mm", {1, 0, 0}}, {"fov", 60}});
+  EXPECT_CONTAINS(error_of(j), "render.cameras[1].fov is an unknown key; did you mean render.cameras[1].fov_deg?");
+}
+
+TEST(SceneErrors, EnumValueSuggestsClosest) {
+  const std::string e = error_of({{"solver", {{"method", "newmark-beta"}}}});
+  EXPECT_CONTAINS(e, "solver.method = \"newmark-beta\" is not allowed");
+  EXPECT_CONTAINS(e, "\"static\", \"explicit\", \"newmark\", \"kitasaka2004\"");
+  EXPECT_CONTAINS(e, "did you mean \"newmark\"?");
+}
+
+// ---- ranges ------------------------------------------------------------------------------------
+
+TEST(SceneErrors, OutOfRangeSamples) {
+  struct Case { json scene; std::string path, value, allowed; };
+  const std::vector<Case> cases{
+      {{{"load", {{"pressure_mmhg", 150}}}}, "load.pressure_mmhg", "150", "allowed: 0 to 100 mmHg"},
+      {{{"mesh", {{"cube_voxels", 0}}}}, "mesh.cube_voxels", "0", "allowed: 1 to 64"},
+      {{{"material", {{"damping_ratio", -1}}}}, "material.damping_ratio", "-1", "allowed: 0 to 10"},
+      {{{"material", {{"young_kpa", 0}}}}, "material.young_kpa", "0", "allowed: > 0 and <= 1000000 kPa"},
+      {{{"solver", {{"dt_safety", 0}}}}, "solver.dt_safety", "0", "allowed: > 0 and <= 1"},
+      {{{"render", {{"step_fraction", 0.6}}}}, "render.step_fraction", "0.6", "allowed: > 0 and <= 0.5"},
+      {{{"roles", {{"wall_labels", {1, 70000}}}}}, "roles.wall_labels[1]", "70000", "allowed: 0 to 65535"},
+      {{{"load", {{"pressure_curve_mmhg", {0, 200}}}}}, "load.pressure_curve_mmhg[1]", "200", "allowed: 0 to 100 mmHg"},
+      {{{"$schema_version", 2}}, "$schema_version", "2", "allowed: 1"},
+  };
+  for (const Case& c : cases) {
+    const std::string e = error_of(c.scene);
+    EXPECT_CONTAINS(e, kOrigin);
+    EXPECT_CONTAINS(e, c.path + " = " + c.value + " is out of range; " + c.allowed);
+  }
+}
+
+TEST(SceneErrors, EveryBoundIsEnforced) {
+  // Just outside each finite bound of each numeric key (items of the full scene included): an
+  // error naming the key's path, the value and the allowed range.
+  const json base = parse_scene(full_scene(), kOrigin).echo();
+  int tested = 0;
+  for_each_key(scene_detail::scene_table(), base, json::json_pointer(), "",
+               [&](const ParamInfo& p, const json::json_pointer& ptr, const std::string& path) {
+    if (p.kind != Kind::Int && p.kind != Kind::Real) return;
+    const auto& r = p.c.range;
+    for (double bad : {r.lo - (r.lo_open ? 0.0 : 1.0), r.hi + (r.hi_open ? 0.0 : 1.0)}) {
+      if (!std::isfinite(bad)) continue;
+      json j = base;
+      j[ptr] = p.kind == Kind::Int ? json(static_cast<int64_t>(bad)) : json(bad);
+      const std::string e = error_of(j);
+      EXPECT_CONTAINS(e, path + " = " + scene_detail::show(j[ptr]) + " is out of range; allowed: " + r.text());
+      ++tested;
+    }
+  });
+  EXPECT_GT(tested, 80);
+}
+
+TEST(SceneErrors, RulesBeyondRanges) {
+  EXPECT_CONTAINS(error_of({{"load", {{"pressure_curve_mmhg", {5, 10, 8}}}}}),
+                  "load.pressure_curve_mmhg = [5,10,8] is not allowed; non-decreasing");
+  EXPECT_CONTAINS(error_of({{"device", "gpu"}}), "device = \"gpu\" is not allowed; \"cpu\", \"opencl\", \"opencl:P:D\"");
+  EXPECT_NE(error_of({{"device", "opencl:0"}}), "");
+  EXPECT_NE(error_of({{"device", "opencl:a:1"}}), "");
+  EXPECT_EQ(error_of({{"device", "opencl:1:0"}}), "");
+  EXPECT_EQ(error_of({{"device", "opencl"}}), "");
+  EXPECT_EQ(error_of({{"$schema_version", 1}}), "");
+  json j = full_scene();
+  j["render"]["cameras"][0]["name"] = "a/b";
+  EXPECT_CONTAINS(error_of(j), "render.cameras[0].name = \"a/b\" is not allowed");
+  j = full_scene();
+  j["render"]["cameras"][0]["up"] = {0, 0, 0};
+  EXPECT_CONTAINS(error_of(j), "render.cameras[0].up = [0,0,0] is not allowed");
+  EXPECT_CONTAINS(error_of({{"roles", {{"fixed_labels", {4, 4}}}}}), "roles.fixed_labels[1] = 4 is listed twice");
+}
+
+// ---- types -------------------------------------------------------------------------------------
+
+TEST(SceneErrors, WrongTypesNameKeyValueAndType) {
+  struct Case { json scene; std::string expect; };
+  const std::vector<Case> cases{
+      {{{"load", {{"pressure_mmhg", "12"}}}}, "load.pressure_mmhg = \"12\" has the wrong type; expected a number"},
+      {{{"load", {{"pressure_mmhg", nullptr}}}}, "load.pressure_mmhg = null has the wrong type; expected a number"},
+      {{{"mesh", {{"cube_voxels", 8.5}}}}, "mesh.cube_voxels = 8.5 has the wrong type; expected an integer"},
+      {{{"mesh", {{"roi_min_mm", {1, 2}}}}}, "mesh.roi_min_mm = [1,2] has the wrong type; expected an array of 3 numbers or null"},
+      {{{"mesh", {{"roi_min_mm", {1, "2", 3}}}}}, "expected an array of 3 numbers"},
+      {{{"material", {{"gravity", "yes"}}}}, "material.gravity = \"yes\" has the wrong type; expected true or false"},
+      {{{"solver", {{"method", 2}}}}, "solver.method = 2 has the wrong type; expected one of \"static\""},
+      {{{"roles", {{"wall_labels", {"skin"}}}}}, "roles.wall_labels[0] = \"skin\" has the wrong type; expected an integer"},
+      {{{"roles", {{"wall_labels", 3}}}}, "roles.wall_labels = 3 has the wrong type; expected an array of integers"},
+      {{{"inputs", json::array()}}, "inputs = [] has the wrong type; expected an object"},
+      {{{"inputs", {{"ct", 5}}}}, "inputs.ct = 5 has the wrong type; expected a path (string) or null"},
+      {{{"render", {{"cameras", json::object()}}}}, "render.cameras = {} has the wrong type; expected an array of objects"},
+      {{{"render", {{"cameras", json::array({1})}}}}, "render.cameras[0] = 1 has the wrong type; expected an object"},
+      {{{"name", 3}}, "name = 3 has the wrong type; expected a string"},
+      {json::array(), "the scene = [] has the wrong type; expected an object"},
+  };
+  for (const Case& c : cases) EXPECT_CONTAINS(error_of(c.scene), c.expect);
+  // An integer written as a float is still an integer.
+  EXPECT_EQ(parse_scene({{"mesh", {{"cube_voxels", 4.0}}}}, kOrigin).mesh.cube_voxels, 4);
+}
+
+// ---- paths -------------------------------------------------------------------------------------
+
+TEST(ScenePaths, RelativeResolveAgainstSceneFolderAbsoluteUntouched) {
+  const Scene s = parse_scene({{"inputs", {{"ct", "ct.nii.gz"}, {"labels", "../shared/labels.nii.gz"}}},
+                               {"output", {{"folder", "/abs/out"}}}},
+                              kOrigin);
+  EXPECT_EQ(s.inputs.ct, "/cases/abdomen/ct.nii.gz");
+  EXPECT_EQ(s.inputs.labels, "/cases/shared/labels.nii.gz");
+  EXPECT_EQ(s.output.folder, "/abs/out");
+  EXPECT_EQ(s.folder, "/cases/abdomen");
+  EXPECT_EQ(s.path, kOrigin);
+  // Unset paths stay unset, and echo as null.
+  const Scene d = parse_scene(json::object(), kOrigin);
+  EXPECT_EQ(d.inputs.ct, "");
+  EXPECT_TRUE(d.echo()["inputs"]["ct"].is_null());
+}
+
+TEST(ScenePaths, LoadSceneResolvesAgainstTheFilesFolder) {
+  const std::string path = write_temp("paths.json", R"({"inputs": {"ct": "data/ct.nii.gz"}})");
+  const Scene s = load_scene(path);
+  EXPECT_EQ(s.inputs.ct, (fs::absolute(path).parent_path() / "data/ct.nii.gz").lexically_normal().string());
+}
+
+TEST(ScenePaths, RequireCt) {
+  const Scene none = parse_scene(json::object(), kOrigin);
+  try {
+    none.require_ct();
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_CONTAINS(e.what(), kOrigin);
+    EXPECT_CONTAINS(e.what(), "inputs.ct");
+  }
+  EXPECT_EQ(parse_scene({{"inputs", {{"ct", "a.nii"}}}}, kOrigin).require_ct(), "/cases/abdomen/a.nii");
+}
+
+// ---- cross-key rules ---------------------------------------------------------------------------
+
+TEST(SceneRules, LabelInTwoRoleListsNamesBoth) {
+  const std::string e = error_of({{"roles", {{"wall_labels", {1, 5}}, {"viscera_labels", json::array({5})}}}});
+  EXPECT_CONTAINS(e, "label 5 is in both roles.wall_labels and roles.viscera_labels");
+}
+
+TEST(SceneRules, RoiBothOrNeitherAndOrdered) {
+  EXPECT_CONTAINS(error_of({{"mesh", {{"roi_min_mm", {0, 0, 0}}}}}),
+                  "mesh.roi_min_mm is set but mesh.roi_max_mm is not");
+  EXPECT_CONTAINS(error_of({{"mesh", {{"roi_min_mm", {0, 0, 0}}, {"roi_max_mm", {1, 0, 1}}}}}),
+                  "mesh.roi_max_mm = [1.0,0.0,1.0] must exceed mesh.roi_min_mm");
+}
+
+TEST(SceneRules, CameraItemErrorsCarryTheIndex) {
+  json j = full_scene();
+  j["render"]["cameras"].push_back({{"name", "b"}, {"position_mm", {0, 0, 0}}, {"look_at_mm", {1, 0, 0}}, {"fov_deg", 200}});
+  EXPECT_CONTAINS(error_of(j), "render.cameras[1].fov_deg = 200 is out of range; allowed: > 0 and <= 180 deg");
+  j["render"]["cameras"][1] = {{"name", "b"}, {"look_at_mm", {1, 0, 0}}};
+  EXPECT_CONTAINS(error_of(j), "render.cameras[1].position_mm is missing; it is required");
+  j["render"]["cameras"][1] = {{"name", "b"}, {"position_mm", {0, 0, 0}}, {"look_at_mm", {0, 0, 5}}};
+  EXPECT_CONTAINS(error_of(j), "render.cameras[1].up = [0.0,0.0,1.0] is parallel to the scope's axis");
+  j["render"]["cameras"][1] = {{"name", "b"}, {"position_mm", {0, 0, 0}}, {"look_at_mm", {0, 0, 0}}};
+  EXPECT_CONTAINS(error_of(j), "render.cameras[1].look_at_mm = [0.0,0.0,0.0] equals position_mm");
+  j["render"]["cameras"][1] = {{"name", "b"}, {"position_mm", {0, 0, 0}}, {"look_at_mm", {1, 0, 0}}, {"fov_deg", 180}};
+  EXPECT_CONTAINS(error_of(j), "render.cameras[1].fov_deg = 180.0 is not allowed with lens \"pinhole\"");
+  j["render"]["cameras"][1]["lens"] = "fisheye";
+  EXPECT_EQ(error_of(j), "");
+  j["render"]["cameras"][1]["name"] = "port";
+  EXPECT_CONTAINS(error_of(j), "render.ports[0].name = \"port\" is used twice (also render.cameras[1])");
+}
+
+TEST(SceneRules, PortTargetsAndPathKeyframes) {
+  json j = full_scene();
+  j["render"]["ports"][0]["target_label"] = 7;
+  EXPECT_CONTAINS(error_of(j), "render.ports[0] gives both target_mm and target_label");
+  j["render"]["ports"][0].erase("target_mm");
+  EXPECT_EQ(error_of(j), "");
+  j["render"]["ports"][0].erase("target_label");
+  EXPECT_CONTAINS(error_of(j), "render.ports[0] gives neither target_mm nor target_label");
+  j = full_scene();
+  j["render"]["paths"][0]["keyframes"].erase(1);
+  EXPECT_CONTAINS(error_of(j), "render.paths[0].keyframes = [{");
+  EXPECT_CONTAINS(error_of(j), "has 1 items; allowed: 2 or more items");
+  j = full_scene();
+  j["render"]["paths"][0]["keyframes"][1]["look_at_mm"] = {0, 10, 0};
+  EXPECT_CONTAINS(error_of(j), "render.paths[0].keyframes[1].look_at_mm = [0.0,10.0,0.0] equals position_mm");
+  j = full_scene();
+  j["material"]["label_young_kpa"].push_back({{"label", 3}, {"young_kpa", 9}});
+  EXPECT_CONTAINS(error_of(j), "material.label_young_kpa[1].label = 3 is listed twice (also material.label_young_kpa[0])");
+}
+
+TEST(SceneRules, Queries) {
+  Scene s = parse_scene({{"roles", {{"wall_labels", json::array({2})}, {"viscera_labels", {5, 6}}, {"fixed_labels", json::array({9})},
+                                    {"unlisted_label_role", "viscera"}}},
+                         {"material", {{"young_kpa", 50}, {"wall_young_kpa", 24}, {"label_young_kpa", json::array({{{"label", 6}, {"young_kpa", 3}}})}}}},
+                        kOrigin);
+  const std::vector<Role> roles = s.label_roles();
+  ASSERT_EQ(roles.size(), 65536u);
+  EXPECT_EQ(roles[2], Role::Wall);
+  EXPECT_EQ(roles[5], Role::Viscera);
+  EXPECT_EQ(roles[9], Role::Fixed);
+  EXPECT_EQ(roles[0], Role::Viscera);
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 2), 24.0);
+  EXPECT_EQ(s.young_kpa_for(Role::Viscera, 5), 50.0);
+  EXPECT_EQ(s.young_kpa_for(Role::Viscera, 6), 3.0);
+  EXPECT_EQ(s.effective_volume_stiffness_kpa(), 0.0);
+  s.solver.method = SolverMethod::Kitasaka2004;
+  EXPECT_EQ(s.effective_volume_stiffness_kpa(), 50.0);
+  s.material.volume_stiffness_kpa = 7.0;
+  EXPECT_EQ(s.effective_volume_stiffness_kpa(), 7.0);
+  EXPECT_STREQ(role_name(Role::Fixed), "fixed");
+  EXPECT_STREQ(enum_name(RenderPreset::CtSoftTissue), "ct-soft-tissue");
+}
+
+// ---- files -------------------------------------------------------------------------------------
+
+TEST(SceneFiles, MalformedJsonGivesLineAndColumn) {
+  const std::string path = write_temp("bad.json", "{\n  \"name\": \"x\",\n  \"load\": {\n    \"pressure_mmhg\": 12,\n  }\n}\n");
+  try {
+    load_scene(path);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(path + ": invalid JSON at line 5, column 3", 0), 0u) << what;
+  }
+}
+
+TEST(SceneFiles, MissingFileDuplicateKeysAndComments) {
+  try {
+    load_scene("/nonexistent/scene.json");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_CONTAINS(e.what(), "/nonexistent/scene.json: cannot open the scene file");
+  }
+  const std::string dup = write_temp("dup.json", R"({"render": {"cameras": [{"name": "a", "name": "b"}]}})");
+  try {
+    load_scene(dup);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_CONTAINS(e.what(), "render.cameras[0].name is given twice");
+  }
+  const std::string huge = write_temp("huge.json", R"({"load": {"pressure_mmhg": 1e999}})");
+  try {
+    load_scene(huge);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_CONTAINS(e.what(), "huge.json: invalid JSON: number overflow");
+  }
+  const std::string commented = write_temp("comments.json", "{\n  // clinical pressure\n  \"load\": {\"pressure_mmhg\": 14} /* mmHg */\n}\n");
+  EXPECT_EQ(load_scene(commented).load.pressure_mmhg, 14.0);
+}
+
+TEST(SceneFiles, EverySceneInTheRepoLoads) {
+  const fs::path dir = fs::path(PNEUMO_SOURCE_DIR) / "scenes";
+  if (!fs::exists(dir)) GTEST_SKIP() << "no scenes/ folder yet";
+  int loaded = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW(load_scene(entry.path().string()));
+    ++loaded;
+  }
+  if (loaded == 0) GTEST_SKIP() << "scenes/ holds no .json yet";
+}
+
+TEST(SceneReference, CommittedFileIsTheGeneratedOne) {
+  const fs::path committed = fs::path(PNEUMO_SOURCE_DIR) / "docs" / "scene_reference.md";
+  std::ifstream in(committed, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  const std::string generated = scene_reference_markdown();
+  if (text.str() != generated) {
+    const std::string fresh = write_temp("scene_reference.md", generated);
+    FAIL() << committed.string() << " is stale (or missing). Regenerate it: "
+           << "pneumo scene --reference > docs/scene_reference.md (the generated text is also in " << fresh << ")";
+  }
+}
+
+TEST(SceneReference, ListsEveryKey) {
+  const std::string md = scene_reference_markdown();
+  for (const char* heading : {"## Top level", "## `load`", "## `render.cameras[]` (each item)",
+                              "## `render.paths[].keyframes[]` (each item)", "## `material.label_young_kpa[]` (each item)"})
+    EXPECT_CONTAINS(md, heading);
+  for (const char* row : {"| `pressure_mmhg` | number | `12.0` | 0 to 100 | mmHg |", "| `fov_deg` | number | `70.0` |",
+                          "| `method` | enum | `\"static\"` | \"static\", \"explicit\", \"newmark\", \"kitasaka2004\" |"})
+    EXPECT_CONTAINS(md, row);
+}
+
+}  // namespace
+}  // namespace pneumo
