@@ -9,6 +9,6 @@ out=${1:-out/demo}
 ./build/pneumo phantom --size small --out "$out" --force
 ./build/pneumo info "$out/ct.nii.gz"
 ./build/pneumo info "$out/labels.nii.gz"
-./build/pneumo scene check "$out/scene.json"
+./build/pneumo scene "$out/scene.json" >/dev/null && echo "scene: $out/scene.json is valid"
 ./build/pneumo devices
 echo "demo: outputs in $out"

@@ -31,6 +31,8 @@ int main(int argc, char** argv) {
   };
   add(cli::add_info);
   add(cli::add_devices);
+  add(cli::add_phantom);
+  add(cli::add_scene);
 
   try {
     app.parse(argc, argv);
