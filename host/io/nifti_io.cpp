@@ -15,6 +15,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/progress.h"
 #include "io/volume_io.h"
 
 namespace pneumo {
@@ -52,7 +53,8 @@ std::string gz_problem(gzFile f) {
 
 /// Reads up to n bytes; returns how many were read, or throws on a corrupt stream.
 uint64_t read_bytes(const std::string& path, gzFile f, void* dst, uint64_t n) {
-  constexpr uint64_t kChunk = 256ull << 20;   // gzread takes an unsigned count
+  constexpr uint64_t kChunk = 16ull << 20;   // gzread takes an unsigned count; progress per chunk
+  Progress progress("read " + path, int64_t(n >> 20));
   uint64_t done = 0;
   char* out = static_cast<char*>(dst);
   while (done < n) {
@@ -60,6 +62,7 @@ uint64_t read_bytes(const std::string& path, gzFile f, void* dst, uint64_t n) {
     const int got = gzread(f, out + done, want);
     if (got < 0) throw file_error(path, "corrupt compressed data: " + gz_problem(f));
     done += static_cast<uint64_t>(got);
+    progress.update(int64_t(done >> 20), "MiB");
     if (static_cast<unsigned>(got) < want) break;
   }
   return done;

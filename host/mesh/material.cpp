@@ -1,0 +1,48 @@
+// Node masses, spring stiffnesses and dampers (method.md §4; Lloyd et al. 2007 for ν = 1/4).
+#include <cmath>
+
+#include "mesh/mesh.h"
+
+namespace pneumo {
+
+double lloyd_tet_spring_k(double young_pa, double volume_m3) {
+  // k_t = (2√2/25)·E_t·l_t with l_t = (6√2·V_t)^(1/3): the edge length of the regular tetrahedron
+  // of the same volume. Summed over the tetrahedra sharing an edge (Nimura's printed Eq. 3 omits
+  // the sum and makes the material ~4.8× too soft, §4).
+  const double l = std::cbrt(6.0 * std::sqrt(2.0) * volume_m3);
+  return 2.0 * std::sqrt(2.0) / 25.0 * young_pa * l;
+}
+
+void assign_material(Mesh& m, const MaterialOptions& opt) {
+  m.mass_kg.assign(m.node_count(), 0.0);
+  m.spring_k.assign(m.springs.size(), 0.0);
+  for (std::size_t t = 0; t < m.tets.size(); ++t) {
+    const double v = m.tet_rest_volume_m3[t];
+    for (int32_t n : m.tets[t]) m.mass_kg[n] += opt.density_kg_m3 * v / 4.0;
+    const double k = opt.spring_scale * lloyd_tet_spring_k(m.tet_young_pa[t], v);
+    for (int32_t s : m.tet_springs[t]) m.spring_k[s] += k;
+  }
+  m.spring_c.assign(m.springs.size(), 0.0);
+  for (std::size_t s = 0; s < m.springs.size(); ++s) {
+    // c = 2ζ√(m k), m the mean of the two node masses (§4).
+    const double mass = 0.5 * (m.mass_kg[m.springs[s][0]] + m.mass_kg[m.springs[s][1]]);
+    m.spring_c[s] = 2.0 * opt.damping_ratio * std::sqrt(mass * m.spring_k[s]);
+  }
+}
+
+Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene) {
+  MeshOptions opt;
+  opt.cube_voxels = scene.mesh.cube_voxels;
+  opt.model = scene.mesh.model;
+  opt.roi_min_mm = scene.mesh.roi_min_mm;
+  opt.roi_max_mm = scene.mesh.roi_max_mm;
+  Mesh m = build_mesh(roles, opt, [&](Role r, int label) { return scene.young_kpa_for(r, label) * 1e3; });
+  MaterialOptions mat;
+  mat.density_kg_m3 = scene.material.density_kg_m3;
+  mat.damping_ratio = scene.material.damping_ratio;
+  mat.spring_scale = scene.material.spring_scale;
+  assign_material(m, mat);
+  return m;
+}
+
+}  // namespace pneumo

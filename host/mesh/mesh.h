@@ -1,0 +1,107 @@
+#pragma once
+// The mass-spring-damper mesh (method.md §3–4): nodes at cube corners of an L×L×L-voxel grid, 5
+// tetrahedra per cube, springs and dampers on every tetrahedron edge, separate wall and viscera
+// meshes (doubled where they touch), fixed nodes and cavity-facing triangles.
+//
+// Units: positions in metres (world RAS+), masses in kg, stiffness in N/m, damping in N·s/m,
+// volumes in m³. Interfaces convert to mm where users see them.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/geometry.h"
+#include "scene/scene.h"
+
+namespace pneumo {
+
+enum class Part : uint8_t { Wall = 0, Viscera = 1 };
+const char* part_name(Part p);
+
+/// Bit mask of world axes a node is held on: 7 = fixed; single bits serve symmetry planes.
+enum : uint8_t { kHoldX = 1, kHoldY = 2, kHoldZ = 4, kHoldAll = 7 };
+
+/// The 6 edges of a tetrahedron as pairs of its local vertices.
+inline constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+
+/// What the mesh is built from: one role and one label per voxel on a grid.
+struct VoxelRoles {
+  Geometry geometry;
+  const Role* role = nullptr;       // voxel_count() entries
+  const uint16_t* label = nullptr;  // optional: organ labels for per-label Young's modulus
+};
+
+struct MeshOptions {
+  int cube_voxels = 8;                     // L
+  MeshModel model = MeshModel::WallViscera;
+  std::optional<Vec3> roi_min_mm, roi_max_mm;   // cubes whose centre lies outside are not meshed
+};
+
+struct MeshStats {
+  int64_t nodes = 0, tetrahedra = 0, springs = 0, cavity_triangles = 0, fixed_nodes = 0;
+  int64_t wall_cubes = 0, viscera_cubes = 0, doubled_cubes = 0;
+  int64_t wall_nodes = 0, viscera_nodes = 0;
+};
+
+struct Mesh {
+  // Nodes.
+  std::vector<Vec3> rest_m;                 // rest position, metres
+  std::vector<Part> node_part;
+  std::vector<uint8_t> hold;                // kHold* mask
+  std::vector<std::array<int32_t, 3>> node_lattice;   // lattice coordinates (cube corners)
+  std::vector<double> mass_kg;              // §4: ρ Σ V_t / 4 (set by assign_material)
+
+  // Tetrahedra (positively oriented at rest).
+  std::vector<std::array<int32_t, 4>> tets;
+  std::vector<Part> tet_part;
+  std::vector<uint16_t> tet_label;          // dominant label of its part in its cube
+  std::vector<int64_t> tet_cube;            // linear cube index
+  std::vector<double> tet_rest_volume_m3;
+  std::vector<double> tet_young_pa;
+  std::vector<std::array<int32_t, 6>> tet_springs;   // spring of each local edge (kTetEdges order)
+
+  // Springs (one per unique tetrahedron edge, per part).
+  std::vector<std::array<int32_t, 2>> springs;
+  std::vector<double> spring_rest_m;
+  std::vector<double> spring_k;             // N/m, §4: Σ over tetrahedra sharing the edge
+  std::vector<double> spring_c;             // N·s/m, §4: 2ζ√(m k)
+
+  // Cavity triangles: oriented with the normal out of their own part's solid (§3).
+  std::vector<std::array<int32_t, 3>> cavity_tris;
+  std::vector<Part> tri_part;
+
+  // Where it came from.
+  Geometry grid;                            // the voxel grid
+  int cube_voxels = 0;
+  std::array<int64_t, 3> cubes{0, 0, 0};    // cubes per axis
+  MeshStats stats;
+
+  int64_t node_count() const { return int64_t(rest_m.size()); }
+};
+
+/// Builds the mesh from voxel roles (§3). Throws InputError when nothing would be meshed.
+/// Young's modulus per tetrahedron comes from `young_pa_for(role, label)`.
+Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const std::function<double(Role, int)>& young_pa_for);
+
+/// The mesh of a scene's roles, with its material assigned.
+Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene);
+
+struct MaterialOptions {
+  double density_kg_m3 = 1096.0;
+  double damping_ratio = 0.4;
+  double spring_scale = 1.0;
+};
+/// Masses, spring stiffnesses (Lloyd) and dampers (§4), from the tetrahedra's volumes and moduli.
+void assign_material(Mesh& mesh, const MaterialOptions& opt);
+
+/// Lloyd's per-tetrahedron spring constant for ν = 1/4 (§4): (2√2/25)·E·(6√2·V)^(1/3), N/m.
+double lloyd_tet_spring_k(double young_pa, double volume_m3);
+
+/// Signed volume of the tetrahedron (a,b,c,d), positive when (b−a, c−a, d−a) is right-handed.
+inline double signed_tet_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return (b - a).cross(c - a).dot(d - a) / 6.0;
+}
+
+}  // namespace pneumo

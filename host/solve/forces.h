@@ -1,0 +1,55 @@
+#pragma once
+// Forces on the mesh nodes (method.md §5), the plain C++ reference in double precision.
+// Positions in metres, velocities in m/s, forces in newtons, pressure in pascal.
+#include <vector>
+
+#include "mesh/adjacency.h"
+#include "mesh/mesh.h"
+
+namespace pneumo {
+
+struct ForceModel {
+  SpringModel spring_model = SpringModel::Nonlinear;
+  bool damping = true;                 // spring dampers c (§4)
+  double pressure_pa = 0.0;            // gas pressure on the cavity triangles
+  double volume_stiffness_pa = 0.0;    // Kitasaka's k_v; 0 = off
+  Vec3 gravity_m_s2 = Vec3::Zero();    // option (Bano); zero = off
+};
+
+/// Evaluates every force term for positions x and velocities v (v may be empty: no damping).
+/// The result has one entry per node; held axes are not zeroed here (the integrators do that).
+/// Gathered per node through `adj`, so it is deterministic and parallel.
+class ForceEvaluator {
+ public:
+  explicit ForceEvaluator(const Mesh& mesh);
+  void evaluate(const ForceModel& model, const std::vector<Vec3>& x, const std::vector<Vec3>& v,
+                std::vector<Vec3>& f);
+  const Adjacency& adjacency() const { return adj_; }
+  int64_t evaluations() const { return evaluations_; }
+
+ private:
+  const Mesh& m_;
+  Adjacency adj_;
+  std::vector<Vec3> spring_f_, tet_f_, tri_f_;   // per element, before the gather
+  int64_t evaluations_ = 0;
+};
+
+/// Nonlinear spring and damper force on node a of spring (a,b): f_a = −k(|d|−|d₀|)d̂ − c(v_ab·d̂)d̂ (§5).
+Vec3 spring_force_nonlinear(const Vec3& xa, const Vec3& xb, const Vec3& va, const Vec3& vb, double rest, double k,
+                            double c);
+/// Nimura's Eq. 1 as printed (option): f_a = −k(d − d₀) − c v_ab. Not rotation-invariant.
+Vec3 spring_force_linear(const Vec3& xa, const Vec3& xb, const Vec3& xa0, const Vec3& xb0, const Vec3& va,
+                         const Vec3& vb, double k, double c);
+/// Gas pressure on triangle (a,b,c): F = −P·S·n, S·n = ½(x_b − x_a)×(x_c − x_a), a third per vertex (§5).
+Vec3 pressure_force_per_vertex(const Vec3& xa, const Vec3& xb, const Vec3& xc, double pressure_pa);
+/// ∂V/∂x_i of a tetrahedron's signed volume, for its 4 vertices.
+std::array<Vec3, 4> tet_volume_gradient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+/// Potential energies (J), for invariants and tests.
+double spring_energy(const Mesh& m, const std::vector<Vec3>& x, SpringModel model);
+double volume_energy(const Mesh& m, const std::vector<Vec3>& x, double volume_stiffness_pa);
+double kinetic_energy(const Mesh& m, const std::vector<Vec3>& v);
+/// Tetrahedra whose signed volume is ≤ 0.
+int64_t count_inverted(const Mesh& m, const std::vector<Vec3>& x);
+
+}  // namespace pneumo

@@ -1,0 +1,58 @@
+// Explicit integration, symplectic Euler (method.md §6): v ← v + Δt a; x ← x + Δt v.
+#include <cmath>
+#include <sstream>
+
+#include "core/units.h"
+#include "solve/solver_common.h"
+
+namespace pneumo {
+
+std::string dt_advice(double dt_s, double dt_stable_s) {
+  std::ostringstream os;
+  os.precision(3);
+  os << "the time step " << dt_s / units::kSecondsPerMs << " ms is too large; set solver.dt_ms "
+     << "below the largest stable step, about " << dt_stable_s / units::kSecondsPerMs << " ms (or 0 for automatic)";
+  return os.str();
+}
+
+double chosen_dt(const Mesh& m, const SolveOptions& opt, bool damping, SolveResult& r) {
+  r.dt_stable_s = stable_time_step(m, damping);
+  r.dt_s = opt.dt_s > 0.0 ? opt.dt_s : opt.dt_safety * r.dt_stable_s;
+  return r.dt_s;
+}
+
+SolveResult solve_explicit(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x) {
+  SolveResult r;
+  detail::Monitor mon(m, opt, "explicit", r);
+  const double dt = chosen_dt(m, opt, opt.forces.damping, r);
+  ForceEvaluator eval(m);
+  std::vector<Vec3> v(m.node_count(), Vec3::Zero()), f;
+  ForceModel model = opt.forces;
+  int64_t held = 0, step = 0;
+  double residual = INFINITY;
+  bool converged = false;
+  std::string reason = "step limit";
+  while (step < opt.max_steps) {
+    const double t = step * dt;
+    model.pressure_pa = opt.forces.pressure_pa * ramp_factor(t, opt.ramp_s, opt.ramp_shape);
+    eval.evaluate(model, x, v, f);
+    for (int64_t n = 0; n < m.node_count(); ++n) v[n] += dt / m.mass_kg[n] * f[n];
+    detail::apply_holds(m, v);
+    for (int64_t n = 0; n < m.node_count(); ++n) x[n] += dt * v[n];
+    ++step;
+    if (step % opt.monitor_every == 0 || step == opt.max_steps) {
+      mon.check_diverged(x, step, dt_advice(dt, r.dt_stable_s));
+      residual = mon.residual(f);
+      if (mon.record(step, t + dt, model.pressure_pa, residual, x, v)) { reason = "inverted tetrahedra"; break; }
+      const bool ramped = t + dt >= opt.ramp_s;
+      held = (ramped && residual < opt.residual_tolerance && mon.max_speed(v) < opt.velocity_tolerance_m_s)
+                 ? held + opt.monitor_every : 0;
+      if (held >= opt.hold_steps) { converged = true; reason = "converged"; break; }
+    }
+  }
+  r.final_pressure_pa = model.pressure_pa;
+  mon.finish(x, v, step, eval.evaluations(), converged, reason, residual);
+  return r;
+}
+
+}  // namespace pneumo

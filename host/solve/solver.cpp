@@ -1,0 +1,75 @@
+#include "solve/solver.h"
+
+#include <cmath>
+
+#include "core/units.h"
+#include "solve/solver_common.h"
+
+namespace pneumo {
+
+// Defined in one file per scheme.
+SolveResult solve_explicit(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x);
+SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x);
+SolveResult solve_kitasaka2004(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x);
+SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x);
+
+double stable_time_step(const Mesh& m, bool damping) {
+  std::vector<double> ksum(m.node_count(), 0.0), csum(m.node_count(), 0.0);
+  for (std::size_t s = 0; s < m.springs.size(); ++s)
+    for (int32_t n : m.springs[s]) {
+      ksum[n] += m.spring_k[s];
+      csum[n] += damping ? m.spring_c[s] : 0.0;
+    }
+  double dt = INFINITY;
+  for (int64_t n = 0; n < m.node_count(); ++n) {
+    if (m.hold[n] == kHoldAll || !(ksum[n] > 0.0)) continue;
+    const double omega = std::sqrt(2.0 * ksum[n] / m.mass_kg[n]);
+    const double xi = csum[n] / (m.mass_kg[n] * omega);
+    dt = std::min(dt, 2.0 / omega * (std::sqrt(1.0 + xi * xi) - xi));
+  }
+  return dt;
+}
+
+double ramp_factor(double t_s, double ramp_s, RampShape shape) {
+  if (!(ramp_s > 0.0) || t_s >= ramp_s) return 1.0;
+  const double tau = std::max(0.0, t_s / ramp_s);
+  return shape == RampShape::Linear ? tau : 0.5 * (1.0 - std::cos(M_PI * tau));
+}
+
+SolveOptions solve_options_from_scene(const Scene& s) {
+  SolveOptions o;
+  o.method = s.solver.method;
+  o.forces.spring_model = s.material.spring_model;
+  o.forces.pressure_pa = units::mmhg_to_pa(s.load.pressure_mmhg);
+  o.forces.volume_stiffness_pa = units::kpa_to_pa(s.effective_volume_stiffness_kpa());
+  if (s.material.gravity) o.forces.gravity_m_s2 = Vec3(0, -9.81, 0);   // supine: down is posterior (−y in RAS)
+  o.dt_s = units::ms_to_s(s.solver.dt_ms);
+  o.dt_safety = s.solver.dt_safety;
+  o.max_steps = s.solver.max_steps;
+  o.residual_tolerance = s.solver.residual_tolerance;
+  o.velocity_tolerance_m_s = s.solver.velocity_tolerance_mm_s * units::kMetresPerMm;
+  o.hold_steps = s.solver.hold_steps;
+  o.ramp_s = units::ms_to_s(s.load.ramp_ms);
+  o.ramp_shape = s.load.ramp_shape;
+  o.newmark_beta = s.solver.newmark_beta;
+  o.newmark_gamma = s.solver.newmark_gamma;
+  o.newmark_inner_tolerance = s.solver.newmark_inner_tolerance;
+  o.newmark_max_inner = s.solver.newmark_max_inner;
+  o.kitasaka_step = s.solver.kitasaka_step;
+  o.kitasaka_tolerance_m = s.solver.kitasaka_tolerance_mm * units::kMetresPerMm;
+  o.on_inverted = s.solver.on_inverted;
+  return o;
+}
+
+SolveResult solve(const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x_start) {
+  std::vector<Vec3> x = x_start.empty() ? m.rest_m : x_start;
+  switch (opt.method) {
+    case SolverMethod::Explicit: return solve_explicit(m, opt, std::move(x));
+    case SolverMethod::Newmark: return solve_newmark(m, opt, std::move(x));
+    case SolverMethod::Kitasaka2004: return solve_kitasaka2004(m, opt, std::move(x));
+    case SolverMethod::Static: return solve_static_fire(m, opt, std::move(x));
+  }
+  throw std::logic_error("unknown solver");
+}
+
+}  // namespace pneumo

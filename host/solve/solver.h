@@ -1,0 +1,76 @@
+#pragma once
+// The solvers of method.md §6, sharing one force evaluation: explicit (symplectic Euler),
+// Newmark-β with its inner loop (Nimura), the 2004 quasi-static scheme (Kitasaka) and a fast static
+// solver (FIRE). The plain C++ reference; SI units inside (m, s, N, Pa).
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mesh/mesh.h"
+#include "scene/scene.h"
+#include "solve/forces.h"
+
+namespace pneumo {
+
+struct SolveOptions {
+  SolverMethod method = SolverMethod::Static;
+  ForceModel forces;                 // pressure_pa is the target pressure
+  double dt_s = 0.0;                 // 0 = dt_safety × the stability estimate
+  double dt_safety = 0.5;
+  int64_t max_steps = 100000;
+  double residual_tolerance = 1e-3;  // max |free net force| / reference load
+  double velocity_tolerance_m_s = 5e-4;
+  int hold_steps = 50;               // convergence must hold this many consecutive steps
+  double ramp_s = 0.5;               // pressure ramp duration (dynamic solvers)
+  RampShape ramp_shape = RampShape::Smooth;
+  double newmark_beta = 0.25, newmark_gamma = 0.5;
+  double newmark_inner_tolerance = 1e-6;
+  int newmark_max_inner = 50;
+  double kitasaka_step = 0.3;
+  double kitasaka_tolerance_m = 1e-3;  // β: Σ|ΔR_i| over all nodes
+  OnInverted on_inverted = OnInverted::Continue;
+  int64_t monitor_every = 10;        // convergence/inversion checks every N steps
+  bool progress = true;
+};
+
+/// The options a scene asks for (units converted to SI).
+SolveOptions solve_options_from_scene(const Scene& scene);
+
+struct SolveSample {              // one row of the convergence history
+  int64_t step = 0;
+  double time_s = 0, pressure_pa = 0, residual = 0, max_displacement_m = 0, max_speed_m_s = 0;
+};
+
+struct SolveResult {
+  std::vector<Vec3> x;            // final positions (m)
+  std::vector<Vec3> v;            // final velocities (m/s; zero for the static schemes)
+  bool converged = false;
+  std::string stop_reason;        // "converged", "step limit", "inverted tetrahedra"
+  std::string solver;
+  int64_t steps = 0, force_evaluations = 0, inner_iterations = 0;
+  double wall_time_s = 0, residual = 0, dt_s = 0, dt_stable_s = 0, final_pressure_pa = 0;
+  int64_t inverted_tetrahedra = 0;
+  std::vector<SolveSample> history;
+};
+
+/// A run that blew up. The message names the parameter to change and the largest stable step.
+class DivergedError : public std::runtime_error {
+ public:
+  DivergedError(const std::string& what, double dt_stable_s)
+      : std::runtime_error(what), dt_stable_s(dt_stable_s) {}
+  double dt_stable_s;
+};
+
+/// Largest stable explicit time step (§6): min over nodes of (2/ω_i)(√(1+ξ_i²) − ξ_i) with
+/// ω_i² = 2Σ_j k_ij/m_i (Gershgorin) and ξ_i = Σ_j c_ij/(m_i ω_i).
+double stable_time_step(const Mesh& m, bool damping);
+
+/// Pressure ramp factor r(t/T) in [0,1] (§6): linear or (1 − cos πτ)/2, then 1.
+double ramp_factor(double t_s, double ramp_s, RampShape shape);
+
+/// Runs the chosen solver from `x_start` (rest positions when empty).
+SolveResult solve(const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x_start = {});
+
+}  // namespace pneumo

@@ -1,0 +1,115 @@
+#include "solve/solver_common.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "core/units.h"
+
+namespace pneumo::detail {
+
+void apply_holds(const Mesh& m, std::vector<Vec3>& vec) {
+  for (int64_t n = 0; n < m.node_count(); ++n) {
+    const uint8_t h = m.hold[n];
+    if (!h) continue;
+    for (int a = 0; a < 3; ++a)
+      if (h & (1 << a)) vec[n][a] = 0.0;
+  }
+}
+
+Monitor::Monitor(const Mesh& m, const SolveOptions& opt, const std::string& solver, SolveResult& r)
+    : m_(m), opt_(opt), r_(r), start_(std::chrono::steady_clock::now()), progress_("solve " + solver, opt.max_steps) {
+  r.solver = solver;
+  // Reference load: the pressure's largest nodal force at rest.
+  std::vector<Vec3> f(m.node_count(), Vec3::Zero());
+  for (const auto& t : m.cavity_tris) {
+    const Vec3 fv = pressure_force_per_vertex(m.rest_m[t[0]], m.rest_m[t[1]], m.rest_m[t[2]], opt.forces.pressure_pa);
+    for (int32_t n : t) f[n] += fv;
+  }
+  double ref = 0.0;
+  for (const auto& v : f) ref = std::max(ref, v.norm());
+  if (!(ref > 0.0)) {
+    for (std::size_t s = 0; s < m.springs.size(); ++s) ref = std::max(ref, 1e-3 * m.spring_k[s] * m.spring_rest_m[s]);
+  }
+  ref_load_ = ref > 0.0 ? ref : 1.0;
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (const auto& x : m.rest_m) { lo = lo.cwiseMin(x); hi = hi.cwiseMax(x); }
+  extent_m_ = std::max((hi - lo).norm(), 1e-3);
+}
+
+double Monitor::residual(const std::vector<Vec3>& f) const {
+  double worst = 0.0;
+  for (int64_t n = 0; n < m_.node_count(); ++n)
+    for (int a = 0; a < 3; ++a)
+      if (!(m_.hold[n] & (1 << a))) worst = std::max(worst, std::abs(f[n][a]));
+  return worst / ref_load_;
+}
+
+double Monitor::max_speed(const std::vector<Vec3>& v) const {
+  double s = 0.0;
+  for (const auto& x : v) s = std::max(s, x.norm());
+  return s;
+}
+
+double Monitor::max_displacement(const std::vector<Vec3>& x) const {
+  double d = 0.0;
+  for (int64_t n = 0; n < m_.node_count(); ++n) d = std::max(d, (x[n] - m_.rest_m[n]).norm());
+  return d;
+}
+
+void Monitor::check_diverged(const std::vector<Vec3>& x, int64_t step, const std::string& advice) const {
+  bool finite = true;
+  double worst = 0.0;
+  for (int64_t n = 0; n < m_.node_count() && finite; ++n) {
+    finite = x[n].allFinite();
+    if (finite) worst = std::max(worst, (x[n] - m_.rest_m[n]).norm());
+  }
+  if (finite && worst <= extent_m_) return;
+  std::ostringstream os;
+  os.precision(3);
+  os << r_.solver << " diverged at step " << step << " ("
+     << (finite ? "a node moved " + std::to_string(units::m_to_mm(worst)) + " mm, beyond the model's size"
+                : std::string("non-finite positions"))
+     << "): " << advice;
+  throw DivergedError(os.str(), r_.dt_stable_s);
+}
+
+bool Monitor::record(int64_t step, double time_s, double pressure_pa, double residual, const std::vector<Vec3>& x,
+                     const std::vector<Vec3>& v) {
+  SolveSample s;
+  s.step = step;
+  s.time_s = time_s;
+  s.pressure_pa = pressure_pa;
+  s.residual = residual;
+  s.max_displacement_m = max_displacement(x);
+  s.max_speed_m_s = v.empty() ? 0.0 : max_speed(v);
+  r_.history.push_back(s);
+  char detail[160];
+  std::snprintf(detail, sizeof detail, "residual %.2e  P %.1f mmHg  max displacement %.1f mm", residual,
+                pressure_pa / units::kPaPerMmHg, units::m_to_mm(s.max_displacement_m));
+  progress_.update(step, detail);
+  if (opt_.on_inverted == OnInverted::Stop) {
+    r_.inverted_tetrahedra = count_inverted(m_, x);
+    return r_.inverted_tetrahedra > 0;
+  }
+  return false;
+}
+
+void Monitor::finish(const std::vector<Vec3>& x, const std::vector<Vec3>& v, int64_t steps, int64_t force_evaluations,
+                     bool converged, const std::string& stop_reason, double residual) {
+  r_.x = x;
+  r_.v = v.empty() ? std::vector<Vec3>(x.size(), Vec3::Zero()) : v;
+  r_.steps = steps;
+  r_.force_evaluations = force_evaluations;
+  r_.converged = converged;
+  r_.stop_reason = stop_reason;
+  r_.residual = residual;
+  r_.inverted_tetrahedra = count_inverted(m_, x);
+  r_.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  char detail[160];
+  std::snprintf(detail, sizeof detail, "%s after %lld steps, residual %.2e", stop_reason.c_str(), (long long)steps,
+                residual);
+  progress_.finish(detail);
+}
+
+}  // namespace pneumo::detail
