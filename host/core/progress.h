@@ -14,7 +14,8 @@ class Progress {
   Progress(std::string stage, int64_t total);
   ~Progress();  // finishes the line if one was shown
   /// Reports `done` of `total`; `detail` is appended (e.g. "residual 3.2e-4"). Cheap to call often.
-  void update(int64_t done, const std::string& detail = "");
+  /// `eta_s` ≥ 0 replaces the ETA estimated from done/total (solvers estimate it from the residual).
+  void update(int64_t done, const std::string& detail = "", double eta_s = -1.0);
   /// Ends the line with a final summary (only if a progress line was shown).
   void finish(const std::string& detail = "");
 
@@ -23,9 +24,9 @@ class Progress {
 
  private:
   using Clock = std::chrono::steady_clock;
-  void print(int64_t done, const std::string& detail, bool final);
+  void print(int64_t done, const std::string& detail, bool final, double eta_s);
   std::string stage_;
-  int64_t total_;
+  int64_t total_, last_done_ = 0;
   Clock::time_point start_, last_print_;
   bool shown_ = false, finished_ = false, tty_;
 };

@@ -18,7 +18,7 @@ void apply_holds(const Mesh& m, std::vector<Vec3>& vec) {
 }
 
 Monitor::Monitor(const Mesh& m, const SolveOptions& opt, const std::string& solver, SolveResult& r)
-    : m_(m), opt_(opt), r_(r), start_(std::chrono::steady_clock::now()), progress_("solve " + solver, opt.max_steps) {
+    : m_(m), opt_(opt), r_(r), start_(std::chrono::steady_clock::now()), progress_("solve " + solver, 0) {
   r.solver = solver;
   // Reference load: the pressure's largest nodal force at rest.
   std::vector<Vec3> f(m.node_count(), Vec3::Zero());
@@ -85,9 +85,21 @@ bool Monitor::record(int64_t step, double time_s, double pressure_pa, double res
   s.max_speed_m_s = v.empty() ? 0.0 : max_speed(v);
   r_.history.push_back(s);
   char detail[160];
-  std::snprintf(detail, sizeof detail, "residual %.2e  P %.1f mmHg  max displacement %.1f mm", residual,
-                pressure_pa / units::kPaPerMmHg, units::m_to_mm(s.max_displacement_m));
-  progress_.update(step, detail);
+  std::snprintf(detail, sizeof detail, "residual %.2e (target %.0e)  P %.1f mmHg  max displacement %.1f mm",
+                residual, opt_.residual_tolerance, pressure_pa / units::kPaPerMmHg,
+                units::m_to_mm(s.max_displacement_m));
+  // ETA from the residual's recent decay rate (log-linear), once it is falling.
+  double eta = -1.0;
+  const std::size_t h = r_.history.size();
+  if (h >= 5 && residual > opt_.residual_tolerance) {
+    const SolveSample& old = r_.history[h - 5];
+    const double rate = (std::log(residual) - std::log(old.residual)) / double(step - old.step);
+    const double seconds_per_step =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count() / double(step);
+    if (rate < 0.0 && std::isfinite(rate))
+      eta = (std::log(opt_.residual_tolerance) - std::log(residual)) / rate * seconds_per_step;
+  }
+  progress_.update(step, detail, eta);
   if (opt_.on_inverted == OnInverted::Stop) {
     r_.inverted_tetrahedra = count_inverted(m_, x);
     return r_.inverted_tetrahedra > 0;

@@ -1,0 +1,149 @@
+#include "pipeline/simulate.h"
+
+#include <chrono>
+#include <filesystem>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "core/units.h"
+#include "mesh/vtu_writer.h"
+
+namespace pneumo {
+
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Anterior in world RAS is +y.
+const Vec3 kAnterior(0.0, 1.0, 0.0);
+}  // namespace
+
+Simulation simulate_scene(const Scene& scene) {
+  Simulation sim;
+  auto t0 = std::chrono::steady_clock::now();
+  sim.roles = load_roles(scene);
+  sim.stage_seconds_roles = seconds_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  sim.mesh = build_scene_mesh(VoxelRoles{sim.roles.geometry, sim.roles.role.data(), sim.roles.label.data()}, scene);
+  sim.stage_seconds_mesh = seconds_since(t0);
+  const MeshStats& s = sim.mesh.stats;
+  std::ostringstream os;
+  os << "mesh: " << s.nodes << " nodes, " << s.tetrahedra << " tetrahedra, " << s.springs << " springs, "
+     << s.cavity_triangles << " cavity triangles, " << s.fixed_nodes << " fixed nodes, " << s.doubled_cubes
+     << " doubled cubes";
+  log::info(os.str());
+  if (s.cavity_triangles == 0)
+    throw InputError("scene " + scene.path + ": the mesh has no cavity triangles (no wall/viscera interface): the gas "
+                     "has nowhere to act; check the role mapping (roles.*_labels) and mesh.model");
+
+  t0 = std::chrono::steady_clock::now();
+  sim.result = solve(sim.mesh, solve_options_from_scene(scene));
+  sim.stage_seconds_solve = seconds_since(t0);
+  return sim;
+}
+
+DeformationMetrics deformation_metrics(const Mesh& m, const std::vector<Vec3>& x) {
+  DeformationMetrics d;
+  int64_t wall = 0, viscera = 0;
+  for (int64_t n = 0; n < m.node_count(); ++n) {
+    const Vec3 u = units::m_to_mm(1.0) * (x[n] - m.rest_m[n]);
+    if (m.hold[n] == kHoldAll) d.max_fixed_displacement_mm = std::max(d.max_fixed_displacement_mm, u.norm());
+    if (m.node_part[n] == Part::Wall) {
+      d.max_wall_displacement_mm = std::max(d.max_wall_displacement_mm, u.norm());
+      d.mean_wall_displacement_mm += u.norm();
+      d.anterior_rise_mm = std::max(d.anterior_rise_mm, u.dot(kAnterior));
+      ++wall;
+    } else {
+      d.mean_viscera_displacement_mm += u.norm();
+      d.mean_viscera_anterior_mm += u.dot(kAnterior);
+      ++viscera;
+    }
+  }
+  if (wall) d.mean_wall_displacement_mm /= double(wall);
+  if (viscera) {
+    d.mean_viscera_displacement_mm /= double(viscera);
+    d.mean_viscera_anterior_mm /= double(viscera);
+  }
+  // Gas volume: the change of the volume the cavity surfaces enclose (divergence theorem; their
+  // normals point out of their solids, into the gas). The surfaces are open where they meet fixed
+  // or unmeshed tissue; taking the rest centroid as origin keeps that rim's contribution small.
+  Vec3 centroid = Vec3::Zero();
+  for (const auto& t : m.cavity_tris) centroid += (m.rest_m[t[0]] + m.rest_m[t[1]] + m.rest_m[t[2]]) / 3.0;
+  if (!m.cavity_tris.empty()) centroid /= double(m.cavity_tris.size());
+  auto enclosed = [&](const std::vector<Vec3>& p) {
+    double v = 0.0;
+    for (const auto& t : m.cavity_tris) {
+      const Vec3 a = p[t[0]] - centroid, b = p[t[1]] - centroid, c = p[t[2]] - centroid;
+      v -= a.dot((b - a).cross(c - a)) / 6.0;
+    }
+    return v;
+  };
+  d.cavity_volume_ml = (enclosed(x) - enclosed(m.rest_m)) * 1e6;   // m³ → ml
+  return d;
+}
+
+nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
+  const MeshStats& s = sim.mesh.stats;
+  const SolveResult& r = sim.result;
+  const DeformationMetrics d = deformation_metrics(sim.mesh, r.x);
+  nlohmann::json j;
+  j["pneumo_version"] = PNEUMO_VERSION;
+  j["scene"] = scene.path;
+  j["device"] = "cpu";
+  j["converged"] = r.converged;
+  j["stop_reason"] = r.stop_reason;
+  j["solver"] = r.solver;
+  j["pressure_mmhg"] = r.final_pressure_pa / units::kPaPerMmHg;
+  j["cube_voxels"] = sim.mesh.cube_voxels;
+  j["nodes"] = s.nodes;
+  j["tetrahedra"] = s.tetrahedra;
+  j["springs"] = s.springs;
+  j["cavity_triangles"] = s.cavity_triangles;
+  j["fixed_nodes"] = s.fixed_nodes;
+  j["wall_cubes"] = s.wall_cubes;
+  j["viscera_cubes"] = s.viscera_cubes;
+  j["doubled_cubes"] = s.doubled_cubes;
+  j["steps"] = r.steps;
+  j["force_evaluations"] = r.force_evaluations;
+  j["inner_iterations"] = r.inner_iterations;
+  j["dt_ms"] = r.dt_s * 1e3;
+  j["dt_stable_ms"] = r.dt_stable_s * 1e3;
+  j["wall_time_s"] = r.wall_time_s;
+  j["residual"] = r.residual;
+  j["max_wall_displacement_mm"] = d.max_wall_displacement_mm;
+  j["mean_wall_displacement_mm"] = d.mean_wall_displacement_mm;
+  j["anterior_rise_mm"] = d.anterior_rise_mm;
+  j["mean_viscera_displacement_mm"] = d.mean_viscera_displacement_mm;
+  j["mean_viscera_anterior_displacement_mm"] = d.mean_viscera_anterior_mm;
+  j["max_fixed_displacement_mm"] = d.max_fixed_displacement_mm;
+  j["cavity_volume_ml"] = d.cavity_volume_ml;
+  j["inverted_tetrahedra"] = r.inverted_tetrahedra;
+  j["roles_ml"] = {{"wall", sim.roles.volume_ml(Role::Wall)},
+                   {"viscera", sim.roles.volume_ml(Role::Viscera)},
+                   {"fixed", sim.roles.volume_ml(Role::Fixed)}};
+  j["stage_seconds"] = {{"roles", sim.stage_seconds_roles}, {"mesh", sim.stage_seconds_mesh},
+                        {"solve", sim.stage_seconds_solve}};
+  return j;
+}
+
+void write_simulation(const Scene& scene, const Simulation& sim, const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  const auto path = [&](const char* name) { return (std::filesystem::path(dir) / name).string(); };
+  write_vtu(sim.mesh, {}, path("mesh_initial.vtu"));
+  write_vtu(sim.mesh, sim.result.x, path("mesh_deformed.vtu"));
+  std::ostringstream csv;
+  csv << "step,time_s,pressure_mmhg,residual,max_displacement_mm,max_speed_mm_s\n";
+  for (const auto& h : sim.result.history)
+    csv << h.step << "," << h.time_s << "," << h.pressure_pa / units::kPaPerMmHg << "," << h.residual << ","
+        << units::m_to_mm(h.max_displacement_m) << "," << units::m_to_mm(h.max_speed_m_s) << "\n";
+  write_text_file_atomic(path("convergence.csv"), csv.str());
+  write_text_file_atomic(path("scene_used.json"), scene.echo().dump(2) + "\n");
+  // metrics.json last: its presence says the run finished.
+  write_text_file_atomic(path("metrics.json"), simulation_metrics(scene, sim).dump(2) + "\n");
+}
+
+}  // namespace pneumo

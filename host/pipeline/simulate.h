@@ -1,0 +1,40 @@
+#pragma once
+// roles → mesh → solve for one scene: what `pneumo simulate` runs, and what the pipeline reuses.
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "mesh/mesh.h"
+#include "roles/roles.h"
+#include "scene/scene.h"
+#include "solve/solver.h"
+
+namespace pneumo {
+
+struct Simulation {
+  RoleVolume roles;
+  Mesh mesh;
+  SolveResult result;
+  double stage_seconds_roles = 0, stage_seconds_mesh = 0, stage_seconds_solve = 0;
+};
+
+/// Runs roles, mesh and the scene's solver on the CPU reference. A DivergedError propagates.
+Simulation simulate_scene(const Scene& scene);
+
+/// Plausibility measures of a solved mesh (method.md §9): displacements of the wall, the largest
+/// anterior rise of the wall, and the gas volume opened between the wall and the viscera.
+struct DeformationMetrics {
+  double max_wall_displacement_mm = 0, mean_wall_displacement_mm = 0, anterior_rise_mm = 0;
+  double mean_viscera_displacement_mm = 0, mean_viscera_anterior_mm = 0;
+  double cavity_volume_ml = 0;
+  double max_fixed_displacement_mm = 0;
+};
+DeformationMetrics deformation_metrics(const Mesh& m, const std::vector<Vec3>& x);
+
+/// The metrics.json of a simulation (keys listed in docs and tests).
+nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim);
+
+/// Writes mesh_initial.vtu, mesh_deformed.vtu, metrics.json, convergence.csv and scene_used.json
+/// into `dir` (created if needed), each atomically.
+void write_simulation(const Scene& scene, const Simulation& sim, const std::string& dir);
+
+}  // namespace pneumo

@@ -1,0 +1,57 @@
+#pragma once
+// Closed-form checks a user can run on their machine (method.md §4 and §10): the lattice's
+// effective Young's modulus along an axis, and Lamé's thick-walled sphere under internal pressure.
+#include <nlohmann/json.hpp>
+
+#include "scene/scene.h"
+#include "solve/solver.h"
+
+namespace pneumo {
+
+/// §4: a block of n×n×(2n) cubes, its bottom held axially, its top displaced axially by a small
+/// strain, sides free; stress = reaction over area, strain measured between the planes at ¼ and ¾
+/// of the length (away from the loaded faces). Young's modulus of the lattice relative to E.
+struct LatticeResult {
+  int cubes_across = 0;
+  double young_ratio_raw = 0;        // σ/ε ÷ E for this block
+  double young_ratio_axis = 0;       // corrected for free sides: raw ÷ (1 − 0.063/n)
+  double expected_axis = 1.140;      // §4
+  int64_t steps = 0;
+  double residual = 0;
+};
+LatticeResult validate_lattice(int cubes_across = 6, double cube_mm = 5.0);
+
+/// §10: hollow sphere (inner radius a, outer b), internal pressure p, E, ν = 1/4. An octant with
+/// symmetry planes, voxelised at the cube size; mean radial displacement of the inner and outer
+/// boundary nodes against the nominal closed form and against the lattice's own moduli (bulk
+/// 0.721·E, shear 0.432·E). Linear elasticity is a small-strain theory, so the model is solved at
+/// `solve_fraction` of the pressure (geometric nonlinearity below 0.5 %) and scaled back to p.
+struct LameOptions {
+  double cube_mm = 5.0;
+  double voxel_mm = 0.0;             // the voxelisation (0: one voxel per cube); cube_mm a multiple of it
+  double inner_mm = 50.0, outer_mm = 100.0;
+  double young_kpa = 60.0;
+  double pressure_mmhg = 10.0;
+  double solve_fraction = 0.1;
+  double residual_tolerance = 1e-6;
+};
+struct LameResult {
+  LameOptions options;
+  double u_inner_mm = 0, u_outer_mm = 0;
+  double u_inner_analytic_mm = 0, u_outer_analytic_mm = 0;            // nominal E, ν = 1/4
+  double u_inner_lattice_mm = 0, u_outer_lattice_mm = 0;              // lattice moduli
+  double rel_error_inner = 0, rel_error_outer = 0;                    // vs nominal
+  double rel_error_inner_lattice = 0, rel_error_outer_lattice = 0;    // vs lattice moduli
+  int64_t nodes = 0, inner_nodes = 0, outer_nodes = 0, steps = 0;
+  double residual = 0, wall_time_s = 0;
+};
+LameResult validate_lame_sphere(const LameOptions& opt);
+
+/// Lamé's radial displacement u(r) of a thick sphere (§10) for bulk modulus K and shear modulus G
+/// (E = 9KG/(3K+G), ν = (3K−2G)/(2(3K+G))): u(r) = p a³/(b³ − a³) · [r/(3K) + b³/(4 G r²)].
+double lame_sphere_u(double r, double a, double b, double p, double bulk, double shear);
+
+nlohmann::json to_json(const LatticeResult& r);
+nlohmann::json to_json(const LameResult& r);
+
+}  // namespace pneumo
