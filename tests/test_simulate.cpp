@@ -1,0 +1,112 @@
+// The phantom inflated at 12 mmHg through the whole CPU chain (roles → mesh → static solver): the
+// anterior wall rises, the viscera move back, no tetrahedron inverts, fixed nodes do not move at all.
+// Also what `pneumo simulate` writes, and the real CT's scene running end to end.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/progress.h"
+#include "io_test_support.h"
+#include "phantom/phantom.h"
+#include "pipeline/simulate.h"
+#include "shared_data.h"
+
+using namespace pneumo;
+using testing_support::ScratchDir;
+
+namespace {
+Scene phantom_scene(const ScratchDir& dir) {
+  Progress::set_enabled(false);
+  const Phantom p = make_phantom(PhantomSize::Small);
+  write_phantom_case(p, PhantomSize::Small, dir.path().string());
+  return load_scene(dir.file("scene.json"));
+}
+}  // namespace
+
+TEST(Simulate, PhantomAt12MmHgRisesOpensACavityAndKeepsFixedNodesStill) {
+  ScratchDir dir;
+  Scene scene = phantom_scene(dir);
+  ASSERT_DOUBLE_EQ(scene.load.pressure_mmhg, 12.0);
+  const Simulation sim = simulate_scene(scene);
+  const SolveResult& r = sim.result;
+  ASSERT_TRUE(r.converged) << r.stop_reason << " residual " << r.residual;
+  EXPECT_EQ(r.inverted_tetrahedra, 0);
+  const DeformationMetrics d = deformation_metrics(sim.mesh, r.x);
+  // The wall must rise visibly: at 12 mmHg with E = 60 kPa a 300 mm-wide, ~30 mm-thick wall rises
+  // by centimetres (Song et al. report 15 % area growth in patients, i.e. tens of mm); 5 mm is a
+  // floor that only a wrong sign or a missing load misses. 150 mm would mean no anchoring.
+  EXPECT_GT(d.anterior_rise_mm, 5.0);
+  EXPECT_LT(d.anterior_rise_mm, 150.0);
+  // The gas pushes the viscera posteriorly: their mean anterior displacement is negative.
+  EXPECT_LT(d.mean_viscera_anterior_mm, 0.0);
+  // Fixed nodes are held exactly (the integrators zero their motion): not one bit of movement.
+  for (int64_t n = 0; n < sim.mesh.node_count(); ++n)
+    if (sim.mesh.hold[n] == kHoldAll) ASSERT_EQ(r.x[n], sim.mesh.rest_m[n]) << "fixed node " << n << " moved";
+  // A cavity opens: a positive gas volume, below the whole abdomen's volume (~10 L).
+  EXPECT_GT(d.cavity_volume_ml, 50.0);
+  EXPECT_LT(d.cavity_volume_ml, 10000.0);
+  std::printf("phantom small at 12 mmHg: anterior rise %.1f mm, cavity %.0f ml, viscera mean anterior %.2f mm, "
+              "%lld steps\n", d.anterior_rise_mm, d.cavity_volume_ml, d.mean_viscera_anterior_mm, (long long)r.steps);
+}
+
+TEST(Simulate, WritesMeshesMetricsAndTheSceneUsed) {
+  ScratchDir dir;
+  Scene scene = phantom_scene(dir);
+  scene.load.pressure_mmhg = 8.0;
+  const Simulation sim = simulate_scene(scene);
+  const std::string out = dir.file("out");
+  write_simulation(scene, sim, out);
+  for (const char* f : {"mesh_initial.vtu", "mesh_deformed.vtu", "metrics.json", "convergence.csv", "scene_used.json"})
+    EXPECT_TRUE(std::filesystem::exists(out + "/" + f)) << f;
+  std::ifstream in(out + "/metrics.json");
+  const auto m = nlohmann::json::parse(in);
+  for (const char* key : {"converged", "stop_reason", "solver", "nodes", "tetrahedra", "springs", "steps",
+                          "force_evaluations", "wall_time_s", "residual", "max_wall_displacement_mm",
+                          "mean_wall_displacement_mm", "anterior_rise_mm", "cavity_volume_ml", "inverted_tetrahedra"})
+    EXPECT_TRUE(m.contains(key)) << key;
+  EXPECT_EQ(m["nodes"], sim.mesh.stats.nodes);
+  EXPECT_EQ(m["solver"], "static");
+  // The VTU declares the mesh's sizes (ParaView reads them from here).
+  std::ifstream vtu(out + "/mesh_deformed.vtu");
+  std::stringstream ss;
+  ss << vtu.rdbuf();
+  EXPECT_NE(ss.str().find("NumberOfPoints=\"" + std::to_string(sim.mesh.stats.nodes) + "\""), std::string::npos);
+  EXPECT_NE(ss.str().find("Name=\"displacement_mm\""), std::string::npos);
+  // Nothing temporary is left behind.
+  for (const auto& e : std::filesystem::directory_iterator(out))
+    EXPECT_NE(e.path().filename().string()[0], '.') << e.path();
+}
+
+TEST(Simulate, NoWallVisceraInterfaceIsAClearError) {
+  ScratchDir dir;
+  Scene scene = phantom_scene(dir);
+  // Everything that is viscera becomes "other": the wall has nothing to push against.
+  scene.roles.other_labels.insert(scene.roles.other_labels.end(), scene.roles.viscera_labels.begin(),
+                                  scene.roles.viscera_labels.end());
+  scene.roles.viscera_labels.clear();
+  try {
+    simulate_scene(scene);
+    FAIL() << "simulated without a cavity";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no cavity triangles"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Simulate, RealCtSceneInflates) {
+  PNEUMO_REQUIRE_SHARED_DATA();
+  Progress::set_enabled(false);
+  Scene scene = load_scene(std::string(PNEUMO_SOURCE_DIR) + "/scenes/totalseg_example.json");
+  const Simulation sim = simulate_scene(scene);
+  ASSERT_TRUE(sim.result.converged) << sim.result.stop_reason;
+  const DeformationMetrics d = deformation_metrics(sim.mesh, sim.result.x);
+  EXPECT_EQ(sim.result.inverted_tetrahedra, 0);
+  EXPECT_GT(d.anterior_rise_mm, 5.0);
+  EXPECT_LT(d.mean_viscera_anterior_mm, 0.0);
+  EXPECT_EQ(d.max_fixed_displacement_mm, 0.0);
+  std::printf("real CT at 12 mmHg: anterior rise %.1f mm, cavity %.0f ml, %lld nodes, %lld steps\n",
+              d.anterior_rise_mm, d.cavity_volume_ml, (long long)sim.mesh.stats.nodes, (long long)sim.result.steps);
+}
