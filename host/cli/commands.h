@@ -12,5 +12,8 @@ Run add_info(CLI::App& app);
 Run add_devices(CLI::App& app);
 Run add_phantom(CLI::App& app);
 Run add_scene(CLI::App& app);
+Run add_roles(CLI::App& app);
+Run add_validate(CLI::App& app);
+Run add_simulate(CLI::App& app);
 
 }  // namespace pneumo::cli

@@ -33,6 +33,9 @@ int main(int argc, char** argv) {
   add(cli::add_devices);
   add(cli::add_phantom);
   add(cli::add_scene);
+  add(cli::add_roles);
+  add(cli::add_validate);
+  add(cli::add_simulate);
 
   try {
     app.parse(argc, argv);

@@ -29,6 +29,12 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
   ForceEvaluator eval(m);
   const int64_t N = m.node_count();
   std::vector<Vec3> v(N, Vec3::Zero()), a(N, Vec3::Zero()), a_next(N), xp(N), vp(N), xt(N), vt(N), f;
+  // The inner loop's change is measured against the accelerations, floored by the acceleration the
+  // reference load gives the heaviest node: near equilibrium the accelerations vanish and rounding
+  // alone would otherwise look like a diverging loop.
+  double heaviest = 0.0;
+  for (double mass : m.mass_kg) heaviest = std::max(heaviest, mass);
+  const double a_floor = mon.reference_load() / heaviest;
   ForceModel model = opt.forces;
   int64_t held = 0, step = 0;
   double residual = INFINITY;
@@ -55,14 +61,14 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
       for (int64_t n = 0; n < N; ++n) change = std::max(change, (a_next[n] - a[n]).norm());
       a.swap(a_next);
       ++r.inner_iterations;
-      const double scale = std::max(max_norm(a), 1e-12);
+      const double scale = std::max(max_norm(a), a_floor);
       if (!std::isfinite(change)) break;
       if (change <= opt.newmark_inner_tolerance * scale) break;
       growing = change > previous_change ? growing + 1 : 0;
       if (growing >= 3) break;   // a fixed-point iteration whose change keeps growing diverges
       previous_change = change;
     }
-    const double scale = std::max(max_norm(a), 1e-12);
+    const double scale = std::max(max_norm(a), a_floor);
     if (!std::isfinite(change) || change > opt.newmark_inner_tolerance * scale) {
       std::ostringstream os;
       os.precision(3);

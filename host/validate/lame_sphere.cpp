@@ -80,16 +80,22 @@ LameResult validate_lame_sphere(const LameOptions& o) {
 
   LameResult out;
   out.options = o;
-  double sum_in = 0, sum_out = 0;
+  // Means over the whole sphere's boundary nodes: an off-plane node of the octant stands for 8 mirror
+  // images, a node on one symmetry plane for 4, on two for 2: weight ½ per plane it lies on, so the
+  // octant's mean equals the whole sphere's (checked against a full-sphere model: same values).
+  double sum_in = 0, sum_out = 0, w_in = 0, w_out = 0;
   for (int64_t i = 0; i < m.node_count(); ++i) {
     if (!side[i]) continue;
     const Vec3 radial = m.rest_m[i].normalized();
     const double u = (r.x[i] - m.rest_m[i]).dot(radial) / o.solve_fraction;
-    if (side[i] & 1) { sum_in += u; ++out.inner_nodes; }
-    if (side[i] & 2) { sum_out += u; ++out.outer_nodes; }
+    double w = 1.0;
+    for (int a = 0; a < 3; ++a)
+      if (m.node_lattice[i][a] == 0) w *= 0.5;
+    if (side[i] & 1) { sum_in += w * u; w_in += w; ++out.inner_nodes; }
+    if (side[i] & 2) { sum_out += w * u; w_out += w; ++out.outer_nodes; }
   }
-  out.u_inner_mm = units::m_to_mm(sum_in / std::max<int64_t>(out.inner_nodes, 1));
-  out.u_outer_mm = units::m_to_mm(sum_out / std::max<int64_t>(out.outer_nodes, 1));
+  out.u_inner_mm = units::m_to_mm(sum_in / std::max(w_in, 1e-300));
+  out.u_outer_mm = units::m_to_mm(sum_out / std::max(w_out, 1e-300));
   const double a = o.inner_mm, b = o.outer_mm, p = units::mmhg_to_pa(o.pressure_mmhg) * 1e-3;   // p in kPa·… mm
   // In mm with E in kPa and p in kPa: u comes out in mm.
   const double Ek = o.young_kpa;

@@ -1,0 +1,158 @@
+#include "roles/auto_roles.h"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "core/log.h"
+#include "core/progress.h"
+#include "roles/back_region.h"
+#include "roles/body_mask.h"
+#include "roles/distance_transform.h"
+#include "roles/label_map.h"
+#include "roles/lateral_to_bone.h"
+
+namespace pneumo {
+
+namespace {
+
+// Not a role: a voxel no rule has decided yet. The enum's underlying type is uint8_t, so any value
+// of it is a valid Role object; this one never leaves this file.
+constexpr Role kUndecided = static_cast<Role>(255);
+
+class StageTimer {
+ public:
+  explicit StageTimer(Progress& p) : progress_(p), last_(Clock::now()) {}
+  void done(int64_t step, const char* stage) {
+    const auto now = Clock::now();
+    log::debug(std::string("roles: ") + stage + " " +
+               std::to_string(std::chrono::duration<double>(now - last_).count()) + " s");
+    last_ = now;
+    progress_.update(step, stage);
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  Progress& progress_;
+  Clock::time_point last_;
+};
+
+/// Rules 1-3: labels, outside, bone. Everything else stays undecided.
+std::vector<Role> decide_by_labels_and_hu(const SceneRoles& r, const std::vector<uint8_t>& body, const float* hu,
+                                          const uint16_t* label) {
+  const int64_t n = int64_t(body.size());
+  const std::vector<Role> table = [&] {
+    Scene s;
+    s.roles = r;
+    return s.label_roles();
+  }();
+  const std::vector<uint8_t> listed = listed_label_ids(r);
+  const bool use_labels = r.auto_use_labels && label != nullptr;
+  const float bone = float(r.auto_bone_threshold_hu);
+  std::vector<Role> role(static_cast<std::size_t>(n));
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v) {
+    if (use_labels && label[v] != 0 && listed[label[v]]) role[v] = table[label[v]];
+    else if (!body[v]) role[v] = Role::Other;
+    else if (hu[v] > bone) role[v] = Role::Fixed;
+    else role[v] = kUndecided;
+  }
+  return role;
+}
+
+/// Rule 4: undecided body voxels behind the spine's front → fixed.
+void fix_the_back(std::vector<Role>& role, const std::vector<uint8_t>& body, const std::vector<SliceCentre>& centres,
+                  const SliceFrame& f) {
+  std::vector<uint8_t> fixed(role.size());
+  const int64_t n = int64_t(role.size());
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v) fixed[v] = role[v] == Role::Fixed;
+  const std::vector<int64_t> front = spine_front_per_slice(fixed, body, centres, f);
+#pragma omp parallel for schedule(static)
+  for (int64_t s = 0; s < f.n_si; ++s) {
+    if (front[s] < 0) continue;
+    for (int64_t a = 0; a < f.n_ap; ++a) {
+      if (f.ant(a) > front[s]) continue;
+      for (int64_t l = 0; l < f.n_lat; ++l) {
+        const int64_t v = f.index(l, a, s);
+        if (role[v] == kUndecided) role[v] = Role::Fixed;
+      }
+    }
+  }
+}
+
+/// Rule 5: the shell, wall anterior and lateral, fixed behind.
+void assign_the_shell(std::vector<Role>& role, const std::vector<uint8_t>& body, const std::vector<SliceCentre>& centres,
+                      const SliceFrame& f, const Geometry& g, const SceneRoles& r) {
+  const std::vector<float> depth_mm = distance_to_outside_mm(body, g);
+  const float thickness = float(r.auto_wall_thickness_mm);
+  const double cos_max = std::cos(r.auto_wall_max_angle_deg * M_PI / 180.0);
+#pragma omp parallel for schedule(static)
+  for (int64_t s = 0; s < f.n_si; ++s) {
+    const SliceCentre& c = centres[s];
+    if (c.count == 0) continue;
+    for (int64_t a = 0; a < f.n_ap; ++a) {
+      const double dy = (double(f.ant(a)) - c.ant) * f.h_ap;  // + = anterior of the centroid
+      for (int64_t l = 0; l < f.n_lat; ++l) {
+        const int64_t v = f.index(l, a, s);
+        if (role[v] != kUndecided || !(depth_mm[v] <= thickness)) continue;
+        const double dx = (double(l) - c.lat) * f.h_lat;
+        const double len = std::hypot(dx, dy);
+        // angle from anterior ≤ max  ⇔  cos(angle) = dy/len ≥ cos(max); the centroid itself counts as anterior
+        const bool front_or_side = len == 0.0 || dy >= cos_max * len;
+        role[v] = front_or_side ? Role::Wall : Role::Fixed;
+      }
+    }
+  }
+}
+
+/// Rule 6: undecided voxels lateral to bone (away from the midline) → fixed.
+void fix_lateral_to_bone(std::vector<Role>& role, const std::vector<uint8_t>& body, const float* hu,
+                         const std::vector<SliceCentre>& centres, const SliceFrame& f, const SceneRoles& r) {
+  const int64_t n = int64_t(role.size());
+  std::vector<uint8_t> bone(static_cast<std::size_t>(n)), undecided(static_cast<std::size_t>(n));
+  const float bone_hu = float(r.auto_bone_threshold_hu);
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v) {
+    bone[v] = body[v] && hu[v] > bone_hu;
+    undecided[v] = role[v] == kUndecided;
+  }
+  const std::vector<uint8_t> lateral = lateral_to_bone(bone, undecided, centres, f);
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v)
+    if (lateral[v]) role[v] = Role::Fixed;
+}
+
+}  // namespace
+
+std::vector<Role> auto_roles(const SceneRoles& r, const Geometry& g, const float* hu, const uint16_t* label) {
+  Progress progress("roles", 6);
+  StageTimer timer(progress);
+  const SliceFrame f = slice_frame(g);
+
+  const std::vector<uint8_t> body = body_mask(hu, g, r.auto_body_threshold_hu);
+  const std::vector<SliceCentre> centres = body_centres(body, f);
+  timer.done(1, "body mask");
+
+  std::vector<Role> role = decide_by_labels_and_hu(r, body, hu, label);
+  timer.done(2, "labels and bone");
+
+  fix_the_back(role, body, centres, f);
+  timer.done(3, "back");
+
+  assign_the_shell(role, body, centres, f, g, r);
+  timer.done(4, "wall shell");
+
+  fix_lateral_to_bone(role, body, hu, centres, f, r);
+  timer.done(5, "lateral to bone");
+
+  const int64_t n = int64_t(role.size());
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v)
+    if (role[v] == kUndecided) role[v] = Role::Viscera;   // rule 7
+  timer.done(6, "viscera");
+  progress.finish();
+  return role;
+}
+
+}  // namespace pneumo

@@ -1,0 +1,47 @@
+#pragma once
+// Automatic roles (roles.source = "auto", method.md §2 option) for a CT whose abdominal wall is not
+// labelled. The rules, in order of precedence (the first that applies decides):
+//   1. labels (auto_use_labels, a label map given): a voxel whose id (not 0) is in a role list keeps
+//      that role, wherever it is;
+//   2. outside the body → other. Body = HU > auto_body_threshold_hu, largest 6-connected part,
+//      holes filled per axial slice (body_mask.h);
+//   3. HU > auto_bone_threshold_hu → fixed (bone);
+//   4. the back: behind the anterior surface of the vertebral column in the slice → fixed
+//      (back_region.h; the column is found from rules 1 and 3's fixed voxels near the midline);
+//   5. the shell: within auto_wall_thickness_mm of the body's surface (3-D Euclidean distance in mm,
+//      spacing respected) → wall where the direction from the slice's body centroid is within
+//      auto_wall_max_angle_deg of anterior, fixed beyond (the back lying on the table);
+//   6. deeper tissue lateral to bone that is at least 40 mm from the midline (hip joints, iliac
+//      wings, pubic rami: the gluteal, hip and thigh muscles) → fixed (lateral_to_bone.h);
+//   7. everything else in the body → viscera.
+// Limits, stated so nobody trusts more than this:
+//   - The wall is a shell of uniform thickness, not the real skin/fat/muscle layers: where the wall
+//     is thinner, unlabelled tissue just behind it (mesenteric fat, unlabelled bowel) becomes wall;
+//     where it is thicker (obesity), its inner muscle layer becomes viscera. Organ labels protect
+//     the organs they cover (rule 1 first).
+//   - Bone is HU only: contrast-filled vessels or bowel, calcifications and metal above the
+//     threshold become fixed unless a label says otherwise.
+//   - One body: a second body part not touching the largest one (an arm beside the torso) is other.
+//     A table touching the body stays in it and ends up fixed (it is behind the spine).
+//   - The back rule is per axial slice and assumes a supine patient with the spine posterior;
+//     without labels, posterior parts of retroperitoneal organs (kidneys, ascending and descending
+//     colon) behind the front of the column become fixed.
+//   - The angle is measured around the slice's centroid, so a very asymmetric section shifts the
+//     wall's lateral limit.
+//   - No diaphragm: without labels, the thorax's contents (aerated lung, filled in as a hole, and the
+//     heart) become viscera. With the lungs and heart labelled fixed (TotalSegmentator has them) the
+//     back rule's run continues from the spine through the heart, and thoracic slices are held.
+//   - Below the pelvic brim the rules are rough: tissue in front of the pubic rami in rows without
+//     bone (the inguinal region, the front of the thighs) becomes viscera.
+#include <cstdint>
+#include <vector>
+
+#include "core/geometry.h"
+#include "scene/scene.h"
+
+namespace pneumo {
+
+/// Roles on grid `g` from `hu` (HU, i fastest) and, when not null, `label` on the same grid.
+std::vector<Role> auto_roles(const SceneRoles& rules, const Geometry& g, const float* hu, const uint16_t* label);
+
+}  // namespace pneumo

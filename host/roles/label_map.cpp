@@ -1,0 +1,105 @@
+#include "roles/label_map.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/log.h"
+
+namespace pneumo {
+
+namespace {
+
+std::string dims_text(const Index3& d) {
+  return std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" + std::to_string(d[2]);
+}
+
+std::string vec_text(const Vec3& v) {
+  std::ostringstream os;
+  os << "(" << v[0] << ", " << v[1] << ", " << v[2] << ")";
+  return os.str();
+}
+
+/// What differs between two grids, first difference only ("" when they are the same grid).
+std::string grid_difference(const Geometry& a, const Geometry& b, double tol_mm) {
+  if (a.dims != b.dims) return "dims " + dims_text(a.dims) + " vs " + dims_text(b.dims);
+  if ((a.spacing_mm - b.spacing_mm).cwiseAbs().maxCoeff() > tol_mm)
+    return "spacing " + vec_text(a.spacing_mm) + " vs " + vec_text(b.spacing_mm) + " mm";
+  if ((a.origin_mm - b.origin_mm).cwiseAbs().maxCoeff() > tol_mm)
+    return "origin " + vec_text(a.origin_mm) + " vs " + vec_text(b.origin_mm) + " mm";
+  if (!a.same_grid(b, tol_mm))
+    return "direction " + a.orientation_code() + " vs " + b.orientation_code() +
+           " (direction matrices differ by more than " + std::to_string(tol_mm) + " mm at the far corner)";
+  return "";
+}
+
+std::string id_list(const std::vector<int>& ids) {
+  std::string s;
+  for (std::size_t n = 0; n < ids.size(); ++n) s += (n ? ", " : "") + std::to_string(ids[n]);
+  return s;
+}
+
+}  // namespace
+
+void check_labels_on_ct_grid(const Geometry& ct, const Geometry& labels, const std::string& ct_name,
+                             const std::string& labels_name) {
+  constexpr double kTolMm = 1e-3;
+  const std::string diff = grid_difference(labels, ct, kTolMm);
+  if (diff.empty()) return;
+  throw InputError(labels_name + ": the label map is not on the grid of the CT " + ct_name + ": " + diff +
+                   " (label map vs CT); resample the labels onto the CT's grid (nearest neighbour)");
+}
+
+void check_label_values(const Volume& labels, const std::string& labels_name) {
+  if (labels.type() == VoxelType::UInt8 || labels.type() == VoxelType::UInt16) return;  // always valid
+  const int64_t n = labels.voxel_count();
+  int64_t first_bad = n;
+  dispatch_voxel_type(labels.type(), const_cast<void*>(labels.raw()), [&](auto* p) {
+#pragma omp parallel for reduction(min : first_bad) schedule(static)
+    for (int64_t v = 0; v < n; ++v) {
+      const double x = static_cast<double>(p[v]);
+      if (!(x >= 0.0 && x <= 65535.0 && x == std::floor(x)) && v < first_bad) first_bad = v;
+    }
+  });
+  if (first_bad == n) return;
+  const Index3& d = labels.geometry().dims;
+  std::ostringstream os;
+  os << "label value " << labels.value(first_bad) << " at voxel (" << first_bad % d[0] << ", "
+     << (first_bad / d[0]) % d[1] << ", " << first_bad / (d[0] * d[1])
+     << "): label ids must be whole numbers 0..65535";
+  throw file_error(labels_name, os.str());
+}
+
+std::vector<Role> roles_from_labels(const std::vector<uint16_t>& label, const std::vector<Role>& table) {
+  std::vector<Role> role(label.size());
+  const int64_t n = int64_t(label.size());
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v) role[v] = table[label[v]];
+  return role;
+}
+
+std::vector<uint8_t> listed_label_ids(const SceneRoles& r) {
+  std::vector<uint8_t> listed(65536, 0);
+  for (const auto* list : {&r.wall_labels, &r.viscera_labels, &r.fixed_labels, &r.other_labels})
+    for (int id : *list) listed[std::size_t(id)] = 1;
+  return listed;
+}
+
+void note_label_coverage(const SceneRoles& r, const std::vector<uint16_t>& label, const std::string& labels_name) {
+  std::vector<uint8_t> present(65536, 0);
+  for (uint16_t id : label) present[id] = 1;  // a byte store per voxel: cheap next to reading the file
+  const std::vector<uint8_t> listed = listed_label_ids(r);
+  std::vector<int> absent, unlisted;
+  for (int id = 0; id < 65536; ++id) {
+    if (listed[id] && !present[id]) absent.push_back(id);
+    if (!listed[id] && present[id] && id != 0) unlisted.push_back(id);
+  }
+  if (!absent.empty())
+    log::warn("roles: label ids listed in the scene but absent from " + labels_name + ": " + id_list(absent) +
+              " (nothing to assign)");
+  if (!unlisted.empty())
+    log::info("roles: label ids in " + labels_name + " that no role list names (role \"" +
+              role_name(r.unlisted_label_role) + "\" in labels mode, HU rules in auto mode): " + id_list(unlisted));
+}
+
+}  // namespace pneumo

@@ -1,0 +1,80 @@
+#include "roles/roles.h"
+
+#include <algorithm>
+
+#include "core/error.h"
+#include "io/volume_io.h"
+#include "roles/auto_roles.h"
+#include "roles/label_map.h"
+
+namespace pneumo {
+
+namespace {
+
+std::string scene_name(const Scene& s) { return s.path.empty() ? std::string("scene") : s.path; }
+std::string ct_name(const Scene& s) { return s.inputs.ct.empty() ? std::string("(CT)") : s.inputs.ct; }
+std::string labels_name(const Scene& s) { return s.inputs.labels.empty() ? std::string("(label map)") : s.inputs.labels; }
+
+void require_labels_if_needed(const Scene& s, bool have_labels) {
+  if (s.roles.source == RoleSource::Labels && !have_labels)
+    throw InputError(scene_name(s) +
+                     ": roles.source is \"labels\" but inputs.labels is not given; give a label map or set "
+                     "roles.source to \"auto\"");
+}
+
+Volume padded_ct_float(const Volume& ct, const PadVoxels& pad) {
+  Volume out(padded_geometry(ct.geometry(), pad), VoxelType::Float32);
+  dispatch_voxel_type(ct.type(), const_cast<void*>(ct.raw()), [&](auto* src) {
+    const std::vector<float> v = pad_array<float>(src, ct.geometry().dims, pad, -1000.0f);
+    std::copy(v.begin(), v.end(), out.data<float>());
+  });
+  return out;
+}
+
+std::vector<uint16_t> padded_labels(const Volume* labels, const Geometry& ct_grid, const PadVoxels& pad) {
+  if (!labels) return std::vector<uint16_t>(std::size_t(padded_geometry(ct_grid, pad).voxel_count()), 0);
+  return dispatch_voxel_type(labels->type(), const_cast<void*>(labels->raw()), [&](auto* src) {
+    return pad_array<uint16_t>(src, labels->geometry().dims, pad, uint16_t(0));
+  });
+}
+
+}  // namespace
+
+int64_t RoleVolume::count(Role r) const { return int64_t(std::count(role.begin(), role.end(), r)); }
+
+double RoleVolume::voxel_volume_ml() const {
+  return geometry.spacing_mm[0] * geometry.spacing_mm[1] * geometry.spacing_mm[2] / 1000.0;
+}
+
+RoleVolume assign_roles(const Scene& scene, const Volume& ct, const Volume* labels) {
+  require_labels_if_needed(scene, labels != nullptr);
+  ct.geometry().validate(ct_name(scene));
+  if (labels) {
+    check_labels_on_ct_grid(ct.geometry(), labels->geometry(), ct_name(scene), labels_name(scene));
+    check_label_values(*labels, labels_name(scene));
+  }
+  RoleVolume rv;
+  rv.pad = pad_voxels(ct.geometry(), pad_mm_of(scene.roles));
+  rv.geometry = padded_geometry(ct.geometry(), rv.pad);
+  rv.ct = padded_ct_float(ct, rv.pad);
+  rv.label = padded_labels(labels, ct.geometry(), rv.pad);
+  if (labels) note_label_coverage(scene.roles, rv.label, labels_name(scene));
+
+  if (scene.roles.source == RoleSource::Labels) {
+    rv.role = roles_from_labels(rv.label, scene.label_roles());
+  } else {
+    rv.role = auto_roles(scene.roles, rv.geometry, rv.ct.data<float>(), labels ? rv.label.data() : nullptr);
+  }
+  return rv;
+}
+
+RoleVolume load_roles(const Scene& scene) {
+  const bool have_labels = !scene.inputs.labels.empty();
+  require_labels_if_needed(scene, have_labels);   // before reading a large CT for nothing
+  const Volume ct = read_volume(scene.require_ct());
+  if (!have_labels) return assign_roles(scene, ct, nullptr);
+  const Volume labels = read_volume(scene.inputs.labels);
+  return assign_roles(scene, ct, &labels);
+}
+
+}  // namespace pneumo

@@ -1,0 +1,37 @@
+#pragma once
+// Roles (method.md §2): which voxels are abdominal wall, viscera, fixed or left out, on the working
+// grid of a case: the CT's grid padded with air as the scene asks (pad.h). Later stages (mesh,
+// warp, render) read everything about the case's voxels from the RoleVolume.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/geometry.h"
+#include "io/volume.h"
+#include "roles/pad.h"
+#include "scene/scene.h"
+
+namespace pneumo {
+
+struct RoleVolume {
+  Geometry geometry;            // the working grid (after padding)
+  PadVoxels pad;                // voxels added at each end of each axis of the CT's grid
+  std::vector<Role> role;       // one per voxel, i fastest
+  std::vector<uint16_t> label;  // organ label per voxel (0 where none or unknown); same size
+  Volume ct;                    // the CT on the same grid, float32 HU (padding -1000)
+
+  int64_t count(Role r) const;
+  double voxel_volume_ml() const;   // spacing product / 1000
+  double volume_ml(Role r) const { return double(count(r)) * voxel_volume_ml(); }
+};
+
+/// Roles of a case from its CT and (may be null) its label map, which must be on the CT's grid.
+/// roles.source "labels": role = Scene::label_roles()[label]; "auto": auto_roles.h's rules.
+/// InputError (naming the files from scene.inputs) for a missing label map in labels mode, a label
+/// map off the CT's grid, or label values that are not ids 0..65535.
+RoleVolume assign_roles(const Scene& scene, const Volume& ct, const Volume* labels);
+
+/// Reads inputs.ct (and inputs.labels when given), then assign_roles.
+RoleVolume load_roles(const Scene& scene);
+
+}  // namespace pneumo
