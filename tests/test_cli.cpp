@@ -1,42 +1,19 @@
 // The pneumo executable as a user meets it: exit codes (0 success, 1 failure, 2 bad input), one-line
 // errors naming the file and the problem, --help and --version on every subcommand, info --json keys.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "io_test_support.h"
+#include "cli_test_support.h"
 #include "shared_data.h"
 
 using pneumo::testing_support::ScratchDir;
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-Result run_cli(const std::string& args) {
-  ScratchDir tmp;
-  const std::string out = tmp.file("stdout"), err = tmp.file("stderr");
-  const std::string cmd = std::string(PNEUMO_CLI_PATH) + " " + args + " >" + out + " 2>" + err + " </dev/null";
-  const int status = std::system(cmd.c_str());
-  Result r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+using pneumo::testing_support::run_pneumo;
 
 int count_lines(const std::string& s) {
   int n = 0;
@@ -47,20 +24,20 @@ int count_lines(const std::string& s) {
 }  // namespace
 
 TEST(Cli, VersionAndHelp) {
-  auto v = run_cli("--version");
+  auto v = run_pneumo("--version");
   EXPECT_EQ(v.code, 0);
   EXPECT_NE(v.out.find("pneumo " PNEUMO_VERSION), std::string::npos) << v.out;
   for (const char* sub : {"", "info", "devices", "phantom", "scene"}) {
-    auto h = run_cli(std::string(sub) + " --help");
+    auto h = run_pneumo(std::string(sub) + " --help");
     EXPECT_EQ(h.code, 0) << sub;
     EXPECT_FALSE(h.out.empty()) << sub;
   }
 }
 
 TEST(Cli, UnknownSubcommandOrOptionIsBadInput) {
-  EXPECT_EQ(run_cli("no-such-command").code, 2);
-  EXPECT_EQ(run_cli("info --no-such-flag x.nii").code, 2);
-  EXPECT_EQ(run_cli("").code, 2);
+  EXPECT_EQ(run_pneumo("no-such-command").code, 2);
+  EXPECT_EQ(run_pneumo("info --no-such-flag x.nii").code, 2);
+  EXPECT_EQ(run_pneumo("").code, 2);
 }
 
 TEST(Cli, BadFilesGiveOneLineNamingTheFileAndExitTwo) {
@@ -68,7 +45,7 @@ TEST(Cli, BadFilesGiveOneLineNamingTheFileAndExitTwo) {
   { std::ofstream(d.file("garbage.nii")) << "this is not a NIfTI file at all, just text that goes on"; }
   { std::ofstream(d.file("empty.mha")); }
   for (const std::string& f : {d.file("missing.nii.gz"), d.file("garbage.nii"), d.file("empty.mha"), d.file("x.png")}) {
-    auto r = run_cli("info " + f);
+    auto r = run_pneumo("info " + f);
     EXPECT_EQ(r.code, 2) << f << ": " << r.err;
     EXPECT_EQ(count_lines(r.err), 1) << r.err;
     EXPECT_NE(r.err.find(f), std::string::npos) << r.err;
@@ -78,7 +55,7 @@ TEST(Cli, BadFilesGiveOneLineNamingTheFileAndExitTwo) {
 
 TEST(Cli, InfoJsonHasTheDocumentedKeys) {
   PNEUMO_REQUIRE_SHARED_DATA();
-  auto r = run_cli("info --json " + pneumo::testing_support::totalseg_dir() + "/example_ct.nii.gz");
+  auto r = run_pneumo("info --json " + pneumo::testing_support::totalseg_dir() + "/example_ct.nii.gz");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   for (const char* key : {"dims", "spacing_mm", "origin_mm", "direction", "orientation", "datatype", "min", "max"})
@@ -92,7 +69,7 @@ TEST(Cli, InfoJsonHasTheDocumentedKeys) {
 
 TEST(Cli, InfoListsLabelIdsAndCounts) {
   PNEUMO_REQUIRE_SHARED_DATA();
-  auto r = run_cli("info --json " + pneumo::testing_support::totalseg_dir() + "/example_seg_fast_force_split.nii.gz");
+  auto r = run_pneumo("info --json " + pneumo::testing_support::totalseg_dir() + "/example_seg_fast_force_split.nii.gz");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["kind"], "label_map");
@@ -107,7 +84,7 @@ TEST(Cli, InfoListsLabelIdsAndCounts) {
 }
 
 TEST(Cli, DevicesListsTheReferenceAndOpenCL) {
-  auto r = run_cli("devices --json");
+  auto r = run_pneumo("devices --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_GE(j.size(), 1u);

@@ -1,49 +1,29 @@
 // `pneumo roles SCENE [--png FILE] [--at X,Y,Z]` as a user meets it: a summary per role, a PNG, and
 // exit code 2 with a one-line message for bad input.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
-#include "io_test_support.h"
+#include "cli_test_support.h"
 
 using pneumo::testing_support::ScratchDir;
 
 namespace {
 
-struct CliResult {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-CliResult run_pneumo(const ScratchDir& dir, const std::string& args) {
-  const std::string out = dir.file("stdout.txt"), err = dir.file("stderr.txt");
-  const std::string cmd = std::string(PNEUMO_CLI_PATH) + " " + args + " >" + out + " 2>" + err + " </dev/null";
-  const int status = std::system(cmd.c_str());
-  CliResult r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
+using pneumo::testing_support::CliResult;
+using pneumo::testing_support::run_pneumo;
+using pneumo::testing_support::slurp;
 
 }  // namespace
 
 TEST(RolesCli, SummarisesAndDrawsThePhantom) {
   ScratchDir dir;
   const std::string c = dir.file("case");
-  ASSERT_EQ(run_pneumo(dir, "-q phantom --size small --out " + c).code, 0);
+  ASSERT_EQ(run_pneumo("-q phantom --size small --out " + c).code, 0);
   const std::string png = dir.file("roles.png");
-  const CliResult r = run_pneumo(dir, "roles " + c + "/scene.json --png " + png + " --at 0,10,-20");
+  const CliResult r = run_pneumo("roles " + c + "/scene.json --png " + png + " --at 0,10,-20");
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* word : {"wall", "viscera", "fixed", "other", "96 x 96 x 96", "padding", "ml"})
     EXPECT_NE(r.out.find(word), std::string::npos) << word << " missing from:\n" << r.out;
@@ -54,11 +34,11 @@ TEST(RolesCli, SummarisesAndDrawsThePhantom) {
 TEST(RolesCli, BadInputIsExitCodeTwoWithTheReason) {
   ScratchDir dir;
   std::ofstream(dir.file("scene.json")) << R"({"inputs": {"ct": "ct.nii.gz"}, "roles": {"source": "labels"}})";
-  CliResult r = run_pneumo(dir, "roles " + dir.file("scene.json"));
+  CliResult r = run_pneumo("roles " + dir.file("scene.json"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("inputs.labels"), std::string::npos) << r.err;
   // A PNG into a folder that does not exist is refused before any work.
-  r = run_pneumo(dir, "roles " + dir.file("scene.json") + " --png " + dir.file("nowhere/x.png"));
+  r = run_pneumo("roles " + dir.file("scene.json") + " --png " + dir.file("nowhere/x.png"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("nowhere"), std::string::npos) << r.err;
 }

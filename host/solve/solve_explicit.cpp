@@ -28,10 +28,9 @@ SolveResult solve_explicit(const Mesh& m, const SolveOptions& opt, std::vector<V
   ForceEvaluator eval(m);
   std::vector<Vec3> v(m.node_count(), Vec3::Zero()), f;
   ForceModel model = opt.forces;
-  int64_t held = 0, step = 0;
+  int64_t step = 0;
   double residual = INFINITY;
-  bool converged = false;
-  std::string reason = "step limit";
+  std::string reason;
   while (step < opt.max_steps) {
     const double t = step * dt;
     model.pressure_pa = opt.forces.pressure_pa * ramp_factor(t, opt.ramp_s, opt.ramp_shape);
@@ -40,18 +39,11 @@ SolveResult solve_explicit(const Mesh& m, const SolveOptions& opt, std::vector<V
     detail::apply_holds(m, v);
     for (int64_t n = 0; n < m.node_count(); ++n) x[n] += dt * v[n];
     ++step;
-    if (step % opt.monitor_every == 0 || step == opt.max_steps) {
-      mon.check_diverged(x, step, dt_advice(dt, r.dt_stable_s));
-      residual = mon.residual(f);
-      if (mon.record(step, t + dt, model.pressure_pa, residual, x, v)) { reason = "inverted tetrahedra"; break; }
-      const bool ramped = t + dt >= opt.ramp_s;
-      held = (ramped && residual < opt.residual_tolerance && mon.max_speed(v) < opt.velocity_tolerance_m_s)
-                 ? held + opt.monitor_every : 0;
-      if (held >= opt.hold_steps) { converged = true; reason = "converged"; break; }
-    }
+    reason = mon.check_dynamic(step, t + dt, model.pressure_pa, f, x, v, dt_advice(dt, r.dt_stable_s), &residual);
+    if (!reason.empty()) break;
   }
   r.final_pressure_pa = model.pressure_pa;
-  mon.finish(x, v, step, eval.evaluations(), converged, reason, residual);
+  mon.finish(x, v, step, eval.evaluations(), reason == "converged", reason.empty() ? "step limit" : reason, residual);
   return r;
 }
 

@@ -36,10 +36,9 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
   for (double mass : m.mass_kg) heaviest = std::max(heaviest, mass);
   const double a_floor = mon.reference_load() / heaviest;
   ForceModel model = opt.forces;
-  int64_t held = 0, step = 0;
+  int64_t step = 0;
   double residual = INFINITY;
-  bool converged = false;
-  std::string reason = "step limit";
+  std::string reason;
   while (step < opt.max_steps) {
     const double t_next = (step + 1) * dt;
     model.pressure_pa = opt.forces.pressure_pa * ramp_factor(t_next, opt.ramp_s, opt.ramp_shape);
@@ -84,18 +83,11 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
     }
     detail::apply_holds(m, v);
     ++step;
-    if (step % opt.monitor_every == 0 || step == opt.max_steps) {
-      mon.check_diverged(x, step, dt_advice(dt, r.dt_stable_s));
-      residual = mon.residual(f);
-      if (mon.record(step, t_next, model.pressure_pa, residual, x, v)) { reason = "inverted tetrahedra"; break; }
-      const bool ramped = t_next >= opt.ramp_s;
-      held = (ramped && residual < opt.residual_tolerance && mon.max_speed(v) < opt.velocity_tolerance_m_s)
-                 ? held + opt.monitor_every : 0;
-      if (held >= opt.hold_steps) { converged = true; reason = "converged"; break; }
-    }
+    reason = mon.check_dynamic(step, t_next, model.pressure_pa, f, x, v, dt_advice(dt, r.dt_stable_s), &residual);
+    if (!reason.empty()) break;
   }
   r.final_pressure_pa = model.pressure_pa;
-  mon.finish(x, v, step, eval.evaluations(), converged, reason, residual);
+  mon.finish(x, v, step, eval.evaluations(), reason == "converged", reason.empty() ? "step limit" : reason, residual);
   return r;
 }
 

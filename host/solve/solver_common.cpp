@@ -107,6 +107,19 @@ bool Monitor::record(int64_t step, double time_s, double pressure_pa, double res
   return false;
 }
 
+std::string Monitor::check_dynamic(int64_t step, double time_s, double pressure_pa, const std::vector<Vec3>& f,
+                                   const std::vector<Vec3>& x, const std::vector<Vec3>& v, const std::string& advice,
+                                   double* residual) {
+  if (step % opt_.monitor_every != 0 && step != opt_.max_steps) return "";
+  check_diverged(x, step, advice);
+  *residual = this->residual(f);
+  if (record(step, time_s, pressure_pa, *residual, x, v)) return "inverted tetrahedra";
+  const bool ramped = time_s >= opt_.ramp_s;
+  const bool still = ramped && *residual < opt_.residual_tolerance && max_speed(v) < opt_.velocity_tolerance_m_s;
+  held_steps_ = still ? held_steps_ + opt_.monitor_every : 0;
+  return held_steps_ >= opt_.hold_steps ? "converged" : "";
+}
+
 void Monitor::finish(const std::vector<Vec3>& x, const std::vector<Vec3>& v, int64_t steps, int64_t force_evaluations,
                      bool converged, const std::string& stop_reason, double residual) {
   r_.x = x;

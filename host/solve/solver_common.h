@@ -26,6 +26,12 @@ class Monitor {
   /// Records a history row, shows progress; returns true when the run must stop for inversion.
   bool record(int64_t step, double time_s, double pressure_pa, double residual, const std::vector<Vec3>& x,
               const std::vector<Vec3>& v);
+  /// Every monitor_every steps of a dynamic scheme: checks divergence, records, and counts how long
+  /// residual and speed have stayed below their tolerances after the ramp. Returns "" to go on, or
+  /// the stop reason ("converged", "inverted tetrahedra"); `residual` is updated when checked.
+  std::string check_dynamic(int64_t step, double time_s, double pressure_pa, const std::vector<Vec3>& f,
+                            const std::vector<Vec3>& x, const std::vector<Vec3>& v, const std::string& advice,
+                            double* residual);
   void finish(const std::vector<Vec3>& x, const std::vector<Vec3>& v, int64_t steps, int64_t force_evaluations,
               bool converged, const std::string& stop_reason, double residual);
   double reference_load() const { return ref_load_; }
@@ -35,6 +41,7 @@ class Monitor {
   const SolveOptions& opt_;
   SolveResult& r_;
   double ref_load_ = 1.0, extent_m_ = 1.0;
+  int64_t held_steps_ = 0;
   std::chrono::steady_clock::time_point start_;
   Progress progress_;
 };
