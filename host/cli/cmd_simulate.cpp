@@ -24,7 +24,9 @@ Run add_simulate(CLI::App& app) {
       throw InputError("device '" + scene.device + "': the OpenCL solver is not built yet; use --device cpu");
     if (std::filesystem::exists(std::filesystem::path(o->out) / "metrics.json") && !o->force)
       throw InputError(o->out + ": already holds a simulation (metrics.json); use --force to overwrite");
-    std::filesystem::create_directories(o->out);
+    std::error_code ec;
+    std::filesystem::create_directories(o->out, ec);
+    if (ec) throw InputError(o->out + ": cannot create the output folder (" + ec.message() + ")");
     check_writable_target((std::filesystem::path(o->out) / "metrics.json").string());
     const Simulation sim = simulate_scene(scene);
     write_simulation(scene, sim, o->out);
