@@ -48,7 +48,8 @@ void ForceEvaluator::evaluate(const ForceModel& model, const std::vector<Vec3>& 
   tri_f_.resize(model.pressure_pa != 0.0 ? R : 0);
   f.resize(N);
 
-#pragma omp parallel
+  // Small meshes stay on one thread: a parallel region costs more than their whole evaluation.
+#pragma omp parallel if (N + S > 20000)
   {
     // Per element: the force on its first node (springs) or on each vertex (tetrahedra).
 #pragma omp for schedule(static)
