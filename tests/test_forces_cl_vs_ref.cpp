@@ -1,0 +1,142 @@
+// The OpenCL force evaluation (kernels/msd_forces.cl, float32) against the double-precision CPU
+// reference (host/solve/forces.cpp), on every OpenCL device found, on random valid meshes and states
+// (a fresh seed each run, printed on failure): random roles, cube sizes, moduli, deformations,
+// velocities, pressure, volume stiffness, gravity, both spring models.
+//
+// Tolerance, per node and axis: 32·ε₃₂·S_i, where ε₃₂ = 2⁻²³ and S_i is the sum of the magnitudes
+// the node's force is built from (Σ k_ij·|x|max over its springs, Σ c_ij·|v|max over its dampers, the
+// magnitudes of its triangle, tetrahedron and gravity terms). Why: the device rounds every position
+// and velocity to float32 (relative error ε₃₂ of |x|max, which a spring multiplies by k), and then
+// sums up to ~40 terms in float; a few ε₃₂ per term, with headroom, is 32·ε₃₂. A wrong index, a
+// missing term or a sign error is many orders of magnitude larger.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "cl/cl_runtime.h"
+#include "mesh/adjacency.h"
+#include "solve/forces.h"
+#include "solve/forces_cl.h"
+
+using namespace pneumo;
+
+namespace {
+
+std::vector<std::string> opencl_devices() {
+  std::vector<std::string> specs;
+  for (const auto& d : ocl::list_devices()) specs.push_back(d.spec());
+  return specs;
+}
+
+struct RandomCase {
+  Mesh mesh;
+  std::vector<Vec3> x, v;
+  ForceModel model;
+};
+
+RandomCase random_case(std::mt19937& rng) {
+  std::uniform_int_distribution<int> dim(3, 8), role(0, 3), cube(1, 2);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Geometry g;
+  g.dims = {dim(rng), dim(rng), dim(rng)};
+  g.spacing_mm = Vec3(1.0 + 3 * u(rng), 1.0 + 3 * u(rng), 1.0 + 3 * u(rng));
+  g.origin_mm = Vec3(-100 + 200 * u(rng), -100 + 200 * u(rng), -100 + 200 * u(rng));
+  std::vector<Role> roles(g.voxel_count());
+  std::vector<uint16_t> labels(g.voxel_count());
+  for (auto& r : roles) r = Role(role(rng));
+  roles[0] = Role::Wall;   // never an empty mesh
+  for (auto& l : labels) l = uint16_t(rng() % 4);
+  MeshOptions mo;
+  mo.cube_voxels = cube(rng);
+  const double young[4] = {20e3 + 80e3 * u(rng), 20e3 + 80e3 * u(rng), 20e3 + 80e3 * u(rng), 20e3 + 80e3 * u(rng)};
+  RandomCase c;
+  c.mesh = build_mesh(VoxelRoles{g, roles.data(), labels.data()}, mo, [&](Role, int label) { return young[label]; });
+  MaterialOptions mat;
+  mat.damping_ratio = 2.0 * u(rng);
+  assign_material(c.mesh, mat);
+  const double h = 1e-3 * g.spacing_mm.minCoeff();
+  for (const Vec3& r : c.mesh.rest_m) {
+    c.x.push_back(r + 0.1 * h * Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5));
+    c.v.push_back(0.05 * Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5));
+  }
+  c.model.spring_model = u(rng) < 0.5 ? SpringModel::Nonlinear : SpringModel::Linear;
+  c.model.damping = u(rng) < 0.8;
+  c.model.pressure_pa = u(rng) < 0.8 ? 4000.0 * u(rng) : 0.0;
+  c.model.volume_stiffness_pa = u(rng) < 0.5 ? 60e3 * u(rng) : 0.0;
+  c.model.gravity_m_s2 = u(rng) < 0.3 ? Vec3(0, -9.81, 0) : Vec3::Zero();
+  return c;
+}
+
+/// Σ of the magnitudes node n's force is made of (see the tolerance above).
+std::vector<double> force_scales(const RandomCase& c) {
+  const Mesh& m = c.mesh;
+  double xmax = 0, vmax = 0;
+  for (const auto& p : c.x) xmax = std::max(xmax, p.cwiseAbs().maxCoeff());
+  for (const auto& p : c.v) vmax = std::max(vmax, p.cwiseAbs().maxCoeff());
+  std::vector<double> s(m.node_count(), 0.0);
+  for (std::size_t e = 0; e < m.springs.size(); ++e)
+    for (int32_t n : m.springs[e]) s[n] += m.spring_k[e] * xmax + (c.model.damping ? m.spring_c[e] * vmax : 0.0);
+  for (const auto& t : m.cavity_tris) {
+    const double f = pressure_force_per_vertex(c.x[t[0]], c.x[t[1]], c.x[t[2]], c.model.pressure_pa).norm();
+    for (int32_t n : t) s[n] += f;
+  }
+  for (std::size_t t = 0; t < m.tets.size(); ++t) {
+    const auto& q = m.tets[t];
+    const auto g = tet_volume_gradient(c.x[q[0]], c.x[q[1]], c.x[q[2]], c.x[q[3]]);
+    const double vol = signed_tet_volume(c.x[q[0]], c.x[q[1]], c.x[q[2]], c.x[q[3]]);
+    const double v0 = m.tet_rest_volume_m3[t];
+    for (int i = 0; i < 4; ++i)
+      s[q[i]] += std::abs(c.model.volume_stiffness_pa) * (std::abs(vol - v0) / v0 + 1.0) * g[i].norm();
+  }
+  for (int64_t n = 0; n < m.node_count(); ++n) s[n] += m.mass_kg[n] * c.model.gravity_m_s2.norm();
+  return s;
+}
+
+class ForcesClVsRef : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ForcesClVsRef, RandomMeshesAndStatesMatchTheReference) {
+  auto ctx = ocl::Context::shared(ocl::parse_device_spec(GetParam()));
+  const unsigned seed = std::random_device{}();
+  SCOPED_TRACE("seed " + std::to_string(seed) + " on " + ctx->info().name);
+  std::mt19937 rng(seed);
+  constexpr double kEps32 = 1.0 / (1 << 23);
+  for (int trial = 0; trial < 20; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const RandomCase c = random_case(rng);
+    std::vector<Vec3> ref, dev;
+    ForceEvaluator(c.mesh).evaluate(c.model, c.x, c.v, ref);
+    ClForceEvaluator cl(*ctx, c.mesh);
+    cl.upload_state(c.x, c.v);
+    cl.evaluate(c.model);
+    cl.download_forces(dev);
+    const std::vector<double> scale = force_scales(c);
+    for (int64_t n = 0; n < c.mesh.node_count(); ++n)
+      for (int a = 0; a < 3; ++a)
+        ASSERT_LE(std::abs(dev[n][a] - ref[n][a]), 32 * kEps32 * scale[n] + 1e-30)
+            << "node " << n << " axis " << a << ": device " << dev[n][a] << ", reference " << ref[n][a];
+  }
+}
+
+TEST_P(ForcesClVsRef, StateStaysOnTheDeviceBetweenEvaluations) {
+  // Evaluating twice without uploading again gives the same bits: nothing is lost or re-uploaded.
+  auto ctx = ocl::Context::shared(ocl::parse_device_spec(GetParam()));
+  std::mt19937 rng(7);
+  const RandomCase c = random_case(rng);
+  ClForceEvaluator cl(*ctx, c.mesh);
+  cl.upload_state(c.x, c.v);
+  std::vector<Vec3> first, second;
+  cl.evaluate(c.model);
+  cl.download_forces(first);
+  cl.evaluate(c.model);
+  cl.download_forces(second);
+  EXPECT_EQ(first, second);
+}
+
+}  // namespace
+
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(ForcesClVsRef);
+INSTANTIATE_TEST_SUITE_P(OpenCL, ForcesClVsRef, ::testing::ValuesIn(opencl_devices()), [](const auto& info) {
+  std::string s = info.param;
+  for (char& ch : s) if (ch == ':') ch = '_';
+  return s;
+});
