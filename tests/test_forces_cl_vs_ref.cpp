@@ -4,11 +4,12 @@
 // velocities, pressure, volume stiffness, gravity, both spring models.
 //
 // Tolerance, per node and axis: 32·ε₃₂·S_i, where ε₃₂ = 2⁻²³ and S_i is the sum of the magnitudes
-// the node's force is built from (Σ k_ij·|x|max over its springs, Σ c_ij·|v|max over its dampers, the
-// magnitudes of its triangle, tetrahedron and gravity terms). Why: the device rounds every position
-// and velocity to float32 (relative error ε₃₂ of |x|max, which a spring multiplies by k), and then
-// sums up to ~40 terms in float; a few ε₃₂ per term, with headroom, is 32·ε₃₂. A wrong index, a
-// missing term or a sign error is many orders of magnitude larger.
+// the node's force is built from (Σ k_ij·(|d₀,ij| + 2|u|max) over its springs, Σ c_ij·|v|max over its
+// dampers, the magnitudes of its triangle, tetrahedron and gravity terms). Why: the device works on
+// displacements u and rounded rest vectors d₀, so a spring's inputs carry a relative error ε₃₂ of
+// its length and of the displacements (which k multiplies), and it then sums up to ~40 terms in
+// float; a few ε₃₂ per term, with headroom, is 32·ε₃₂. A wrong index, a missing term or a sign error
+// is orders of magnitude larger, and so is the ~50× larger rounding of absolute world positions.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -70,12 +71,13 @@ RandomCase random_case(std::mt19937& rng) {
 /// Σ of the magnitudes node n's force is made of (see the tolerance above).
 std::vector<double> force_scales(const RandomCase& c) {
   const Mesh& m = c.mesh;
-  double xmax = 0, vmax = 0;
-  for (const auto& p : c.x) xmax = std::max(xmax, p.cwiseAbs().maxCoeff());
+  double umax = 0, vmax = 0;
+  for (int64_t n = 0; n < m.node_count(); ++n) umax = std::max(umax, (c.x[n] - m.rest_m[n]).norm());
   for (const auto& p : c.v) vmax = std::max(vmax, p.cwiseAbs().maxCoeff());
   std::vector<double> s(m.node_count(), 0.0);
   for (std::size_t e = 0; e < m.springs.size(); ++e)
-    for (int32_t n : m.springs[e]) s[n] += m.spring_k[e] * xmax + (c.model.damping ? m.spring_c[e] * vmax : 0.0);
+    for (int32_t n : m.springs[e])
+      s[n] += m.spring_k[e] * (m.spring_rest_m[e] + 2 * umax) + (c.model.damping ? m.spring_c[e] * vmax : 0.0);
   for (const auto& t : m.cavity_tris) {
     const double f = pressure_force_per_vertex(c.x[t[0]], c.x[t[1]], c.x[t[2]], c.model.pressure_pa).norm();
     for (int32_t n : t) s[n] += f;

@@ -15,13 +15,12 @@ Run add_simulate(CLI::App& app) {
   auto o = std::make_shared<Opts>();
   cmd->add_option("scene", o->scene, "Scene .json")->required();
   cmd->add_option("--out", o->out, "Output folder")->required();
-  cmd->add_option("--device", o->device, "cpu (the C++ reference); overrides the scene's device");
+  cmd->add_option("--device", o->device, "cpu (the C++ reference), opencl or opencl:P:D; overrides the scene's device");
   cmd->add_flag("--force", o->force, "Overwrite the results of an earlier run in --out");
   return [=] {
     Scene scene = load_scene(o->scene);
     if (!o->device.empty()) scene.device = o->device;
-    if (ocl::parse_device_spec(scene.device).use_opencl)
-      throw InputError("device '" + scene.device + "': the OpenCL solver is not built yet; use --device cpu");
+    ocl::parse_device_spec(scene.device);   // a bad --device is bad input before any work
     if (std::filesystem::exists(std::filesystem::path(o->out) / "metrics.json") && !o->force)
       throw InputError(o->out + ": already holds a simulation (metrics.json); use --force to overwrite");
     std::error_code ec;

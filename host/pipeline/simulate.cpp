@@ -8,7 +8,9 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/units.h"
+#include "cl/cl_runtime.h"
 #include "mesh/vtu_writer.h"
+#include "solve/solver_cl.h"
 
 namespace pneumo {
 
@@ -41,7 +43,16 @@ Simulation simulate_scene(const Scene& scene) {
                      "has nowhere to act; check the role mapping (roles.*_labels) and mesh.model");
 
   t0 = std::chrono::steady_clock::now();
-  sim.result = solve(sim.mesh, solve_options_from_scene(scene));
+  const ocl::DeviceSpec device = ocl::parse_device_spec(scene.device);
+  if (device.use_opencl) {
+    auto ctx = ocl::Context::shared(device);
+    sim.device = ctx->info().spec() + " " + ctx->info().name;
+    log::info("solving on " + sim.device);
+    sim.result = solve_opencl(*ctx, sim.mesh, solve_options_from_scene(scene));
+  } else {
+    sim.device = "cpu";
+    sim.result = solve(sim.mesh, solve_options_from_scene(scene));
+  }
   sim.stage_seconds_solve = seconds_since(t0);
   return sim;
 }
@@ -93,7 +104,7 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   nlohmann::json j;
   j["pneumo_version"] = PNEUMO_VERSION;
   j["scene"] = scene.path;
-  j["device"] = "cpu";
+  j["device"] = sim.device;
   j["converged"] = r.converged;
   j["stop_reason"] = r.stop_reason;
   j["solver"] = r.solver;

@@ -14,10 +14,12 @@ struct Simulation {
   RoleVolume roles;
   Mesh mesh;
   SolveResult result;
+  std::string device;   // "cpu" or "opencl:P:D <name>"
   double stage_seconds_roles = 0, stage_seconds_mesh = 0, stage_seconds_solve = 0;
 };
 
-/// Runs roles, mesh and the scene's solver on the CPU reference. A DivergedError propagates.
+/// Runs roles, mesh and the scene's solver on the scene's device (the CPU reference or OpenCL).
+/// A DivergedError propagates.
 Simulation simulate_scene(const Scene& scene);
 
 /// Plausibility measures of a solved mesh (method.md §9): displacements of the wall, the largest

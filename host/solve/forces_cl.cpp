@@ -47,9 +47,9 @@ uint64_t ClForceEvaluator::device_bytes(const Mesh& m) {
   const Adjacency a = Adjacency::of(m);
   const uint64_t N = m.node_count();
   const uint64_t ss = max_degree(a.springs, N), ts = max_degree(a.tris, N), vs = max_degree(a.tets, N);
-  return N * (4 * 16 + 4)                       // x, v, rest, force; mass
-         + ss * N * 16                          // neighbour, k, c, rest length
-         + m.cavity_tris.size() * 32 + ts * N * 4 + m.tets.size() * (16 + 4 + 64) + vs * N * 4;
+  return N * (4 * 16 + 4)                       // u, v, rest, force; mass
+         + ss * N * 28                          // neighbour, k, c, rest vector and length
+         + m.cavity_tris.size() * 32 + ts * N * 4 + m.tets.size() * (16 + 64) + vs * N * 4;
 }
 
 ClForceEvaluator::ClForceEvaluator(ocl::Context& ctx, const Mesh& m)
@@ -64,14 +64,17 @@ ClForceEvaluator::ClForceEvaluator(ocl::Context& ctx, const Mesh& m)
   // Springs seen from each node: the other end, and the spring's constants.
   const std::vector<int> spring_of = padded_table(adj.springs, nodes_, spring_slots_, [](int32_t it) { return it; });
   std::vector<int> other(spring_of.size(), -1);
-  std::vector<float> k(spring_of.size(), 0.f), c(spring_of.size(), 0.f), rest(spring_of.size(), 0.f);
+  std::vector<float> k(spring_of.size(), 0.f), c(spring_of.size(), 0.f);
+  std::vector<cl_float4> rest(spring_of.size(), cl_float4{{0, 0, 0, 0}});
   for (std::size_t e = 0; e < spring_of.size(); ++e) {
     if (spring_of[e] < 0) continue;
     const int s = spring_of[e] / 8, slot = spring_of[e] % 8;
     other[e] = m.springs[s][1 - slot];
     k[e] = float(m.spring_k[s]);
     c[e] = float(m.spring_c[s]);
-    rest[e] = float(m.spring_rest_m[s]);
+    const Vec3 d0 = m.rest_m[m.springs[s][slot]] - m.rest_m[m.springs[s][1 - slot]];   // in double, then rounded
+    const Vec3 d0f = d0.cast<float>().cast<double>();
+    rest[e] = {{float(d0[0]), float(d0[1]), float(d0[2]), float(d0f.norm())}};
   }
   spring_node_ = upload(ctx, other);
   spring_k_ = upload(ctx, k);
@@ -86,13 +89,12 @@ ClForceEvaluator::ClForceEvaluator(ocl::Context& ctx, const Mesh& m)
   for (std::size_t t = 0; t < tets.size(); ++t) tets[t] = {{m.tets[t][0], m.tets[t][1], m.tets[t][2], m.tets[t][3]}};
   tris_buf_ = upload(ctx, tris);
   tets_buf_ = upload(ctx, tets);
-  std::vector<float> rest_volume(m.tets.size()), mass(nodes_, 0.f);
-  for (std::size_t t = 0; t < rest_volume.size(); ++t) rest_volume[t] = float(m.tet_rest_volume_m3[t]);
+  std::vector<float> mass(nodes_, 0.f);
   for (int64_t n = 0; n < nodes_ && !m.mass_kg.empty(); ++n) mass[n] = float(m.mass_kg[n]);
-  rest_volume_ = upload(ctx, rest_volume);
   mass_ = upload(ctx, mass);
   rest_x_ = upload(ctx, to_float4(m.rest_m));
-  x_ = upload(ctx, to_float4(m.rest_m), CL_MEM_READ_WRITE);
+  rest_m_ = m.rest_m;
+  x_ = upload(ctx, std::vector<cl_float4>(nodes_, cl_float4{{0, 0, 0, 0}}), CL_MEM_READ_WRITE);
   v_ = upload(ctx, std::vector<cl_float4>(nodes_, cl_float4{{0, 0, 0, 0}}), CL_MEM_READ_WRITE);
   f_ = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(nodes_, 1) * sizeof(cl_float4));
   tri_force_ = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(tris_, 1) * sizeof(cl_float4));
@@ -109,7 +111,9 @@ ClForceEvaluator::ClForceEvaluator(ocl::Context& ctx, const Mesh& m)
 
 void ClForceEvaluator::upload_state(const std::vector<Vec3>& x, const std::vector<Vec3>& v) {
   auto& q = ctx_.queue();
-  q.enqueueWriteBuffer(x_, CL_TRUE, 0, nodes_ * sizeof(cl_float4), to_float4(x).data());
+  std::vector<Vec3> u(nodes_);
+  for (int64_t n = 0; n < nodes_; ++n) u[n] = x[n] - rest_m_[n];   // in double, then rounded
+  q.enqueueWriteBuffer(x_, CL_TRUE, 0, nodes_ * sizeof(cl_float4), to_float4(u).data());
   if (!v.empty()) q.enqueueWriteBuffer(v_, CL_TRUE, 0, nodes_ * sizeof(cl_float4), to_float4(v).data());
 }
 
@@ -118,16 +122,17 @@ void ClForceEvaluator::evaluate(const ForceModel& model) {
   const bool pressure = model.pressure_pa != 0.0 && tris_ > 0, volume = model.volume_stiffness_pa != 0.0;
   if (pressure) {
     k_tri_.setArg(0, x_);
-    k_tri_.setArg(1, tris_buf_);
-    k_tri_.setArg(2, float(model.pressure_pa));
-    k_tri_.setArg(3, cl_int(tris_));
-    k_tri_.setArg(4, tri_force_);
+    k_tri_.setArg(1, rest_x_);
+    k_tri_.setArg(2, tris_buf_);
+    k_tri_.setArg(3, float(model.pressure_pa));
+    k_tri_.setArg(4, cl_int(tris_));
+    k_tri_.setArg(5, tri_force_);
     q.enqueueNDRangeKernel(k_tri_, cl::NullRange, cl::NDRange(global_size(tris_)), cl::NDRange(kLocal));
   }
   if (volume) {
     k_tet_.setArg(0, x_);
-    k_tet_.setArg(1, tets_buf_);
-    k_tet_.setArg(2, rest_volume_);
+    k_tet_.setArg(1, rest_x_);
+    k_tet_.setArg(2, tets_buf_);
     k_tet_.setArg(3, float(model.volume_stiffness_pa));
     k_tet_.setArg(4, cl_int(tets_));
     k_tet_.setArg(5, tet_force_);
@@ -136,7 +141,6 @@ void ClForceEvaluator::evaluate(const ForceModel& model) {
   int a = 0;
   k_node_.setArg(a++, x_);
   k_node_.setArg(a++, v_);
-  k_node_.setArg(a++, rest_x_);
   k_node_.setArg(a++, mass_);
   k_node_.setArg(a++, cl_int(nodes_));
   k_node_.setArg(a++, spring_node_);
@@ -156,6 +160,14 @@ void ClForceEvaluator::evaluate(const ForceModel& model) {
                                  float(model.gravity_m_s2[2]), 0.0f}});
   k_node_.setArg(a++, f_);
   q.enqueueNDRangeKernel(k_node_, cl::NullRange, cl::NDRange(global_size(nodes_)), cl::NDRange(kLocal));
+}
+
+std::vector<Vec3> ClForceEvaluator::download_positions(cl::Buffer& u) {
+  std::vector<cl_float4> raw(nodes_);
+  ctx_.queue().enqueueReadBuffer(u, CL_TRUE, 0, nodes_ * sizeof(cl_float4), raw.data());
+  std::vector<Vec3> x(nodes_);
+  for (int64_t n = 0; n < nodes_; ++n) x[n] = rest_m_[n] + Vec3(raw[n].s[0], raw[n].s[1], raw[n].s[2]);
+  return x;
 }
 
 void ClForceEvaluator::download_forces(std::vector<Vec3>& f) {

@@ -1,30 +1,15 @@
 // Explicit integration, symplectic Euler (method.md §6): v ← v + Δt a; x ← x + Δt v.
 #include <cmath>
-#include <sstream>
 
 #include "core/units.h"
 #include "solve/solver_common.h"
 
 namespace pneumo {
 
-std::string dt_advice(double dt_s, double dt_stable_s) {
-  std::ostringstream os;
-  os.precision(3);
-  os << "the time step " << dt_s / units::kSecondsPerMs << " ms is too large; set solver.dt_ms "
-     << "below the largest stable step, about " << dt_stable_s / units::kSecondsPerMs << " ms (or 0 for automatic)";
-  return os.str();
-}
-
-double chosen_dt(const Mesh& m, const SolveOptions& opt, bool damping, SolveResult& r) {
-  r.dt_stable_s = stable_time_step(m, damping);
-  r.dt_s = opt.dt_s > 0.0 ? opt.dt_s : opt.dt_safety * r.dt_stable_s;
-  return r.dt_s;
-}
-
 SolveResult solve_explicit(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x) {
   SolveResult r;
   detail::Monitor mon(m, opt, "explicit", r);
-  const double dt = chosen_dt(m, opt, opt.forces.damping, r);
+  const double dt = detail::chosen_dt(m, opt, opt.forces.damping, r);
   ForceEvaluator eval(m);
   std::vector<Vec3> v(m.node_count(), Vec3::Zero()), f;
   ForceModel model = opt.forces;
@@ -39,7 +24,7 @@ SolveResult solve_explicit(const Mesh& m, const SolveOptions& opt, std::vector<V
     detail::apply_holds(m, v);
     for (int64_t n = 0; n < m.node_count(); ++n) x[n] += dt * v[n];
     ++step;
-    reason = mon.check_dynamic(step, t + dt, model.pressure_pa, f, x, v, dt_advice(dt, r.dt_stable_s), &residual);
+    reason = mon.check_dynamic(step, t + dt, model.pressure_pa, f, x, v, detail::dt_advice(dt, r.dt_stable_s), &residual);
     if (!reason.empty()) break;
   }
   r.final_pressure_pa = model.pressure_pa;

@@ -1,7 +1,8 @@
 // The 2004 quasi-static scheme (method.md §6, Kitasaka §2.4): R_i ← R_i + Δs F_i / D_i, with D_i the
 // sum of node i's spring stiffnesses (a Jacobi-scaled step: Δs is dimensionless and the paper's 0.3
 // is meaningful). Forces: springs (no dampers), volume preservation, pressure; no mass. Nodes are
-// updated one after another in index order (Gauss–Seidel), as the paper's sequential loop does;
+// updated one after another in index order (Gauss–Seidel), as the paper's sequential loop does
+// (kitasaka_jacobi: all at once, as the device does, for comparing the two step by step);
 // stop when Σ_i |ΔR_i| < β.
 #include <cmath>
 #include <sstream>
@@ -48,9 +49,7 @@ SolveResult solve_kitasaka2004(const Mesh& m, const SolveOptions& opt, std::vect
   ForceEvaluator eval(m);   // for the residual, and the adjacency
   const Adjacency& adj = eval.adjacency();
   const int64_t N = m.node_count();
-  std::vector<double> stiffness(N, 0.0);
-  for (std::size_t s = 0; s < m.springs.size(); ++s)
-    for (int32_t n : m.springs[s]) stiffness[n] += m.spring_k[s];
+  const std::vector<double> stiffness = detail::stiffness_sums(m);
   ForceModel model = opt.forces;
   model.damping = false;
   std::vector<Vec3> f;
@@ -58,12 +57,13 @@ SolveResult solve_kitasaka2004(const Mesh& m, const SolveOptions& opt, std::vect
   double residual = INFINITY, moved = INFINITY;
   bool converged = false;
   std::string reason = "step limit";
-  const std::string advice = "solver.kitasaka_step is too large for this mesh; try a smaller value (the paper uses 0.3)";
+  const std::string advice = detail::kKitasakaAdvice;
   while (step < opt.max_steps) {
     moved = 0.0;
+    if (opt.kitasaka_jacobi) eval.evaluate(model, x, {}, f);   // every node from the same positions
     for (int64_t n = 0; n < N; ++n) {
       if (m.hold[n] == kHoldAll || !(stiffness[n] > 0.0)) continue;
-      Vec3 d = opt.kitasaka_step / stiffness[n] * node_force(m, adj, model, x, n);
+      Vec3 d = opt.kitasaka_step / stiffness[n] * (opt.kitasaka_jacobi ? f[n] : node_force(m, adj, model, x, n));
       for (int a = 0; a < 3; ++a)
         if (m.hold[n] & (1 << a)) d[a] = 0.0;
       x[n] += d;

@@ -10,8 +10,6 @@
 
 namespace pneumo {
 
-std::string dt_advice(double dt_s, double dt_stable_s);
-double chosen_dt(const Mesh& m, const SolveOptions& opt, bool damping, SolveResult& r);
 
 namespace {
 double max_norm(const std::vector<Vec3>& a) {
@@ -24,7 +22,7 @@ double max_norm(const std::vector<Vec3>& a) {
 SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x) {
   SolveResult r;
   detail::Monitor mon(m, opt, "newmark", r);
-  const double dt = chosen_dt(m, opt, opt.forces.damping, r);
+  const double dt = detail::chosen_dt(m, opt, opt.forces.damping, r);
   const double beta = opt.newmark_beta, gamma = opt.newmark_gamma;
   ForceEvaluator eval(m);
   const int64_t N = m.node_count();
@@ -32,9 +30,7 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
   // The inner loop's change is measured against the accelerations, floored by the acceleration the
   // reference load gives the heaviest node: near equilibrium the accelerations vanish and rounding
   // alone would otherwise look like a diverging loop.
-  double heaviest = 0.0;
-  for (double mass : m.mass_kg) heaviest = std::max(heaviest, mass);
-  const double a_floor = mon.reference_load() / heaviest;
+  const double a_floor = detail::newmark_acceleration_floor(m, mon);
   ForceModel model = opt.forces;
   int64_t step = 0;
   double residual = INFINITY;
@@ -69,13 +65,8 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
     }
     const double scale = std::max(max_norm(a), a_floor);
     if (!std::isfinite(change) || change > opt.newmark_inner_tolerance * scale) {
-      std::ostringstream os;
-      os.precision(3);
-      os << "newmark inner loop did not converge at step " << step + 1 << " (relative change " << change / scale
-         << " after " << k + 1 << " iterations, limit " << opt.newmark_inner_tolerance << "): "
-         << dt_advice(dt, r.dt_stable_s)
-         << "; the loop converges only for ωΔt < 2(√(1+ξ²) − ξ), like explicit integration";
-      throw DivergedError(os.str(), r.dt_stable_s);
+      throw DivergedError(detail::newmark_failure(step + 1, change / scale, k + 1, opt, dt, r.dt_stable_s),
+                          r.dt_stable_s);
     }
     for (int64_t n = 0; n < N; ++n) {
       x[n] = xp[n] + beta * dt * dt * a[n];
@@ -83,7 +74,7 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
     }
     detail::apply_holds(m, v);
     ++step;
-    reason = mon.check_dynamic(step, t_next, model.pressure_pa, f, x, v, dt_advice(dt, r.dt_stable_s), &residual);
+    reason = mon.check_dynamic(step, t_next, model.pressure_pa, f, x, v, detail::dt_advice(dt, r.dt_stable_s), &residual);
     if (!reason.empty()) break;
   }
   r.final_pressure_pa = model.pressure_pa;

@@ -15,50 +15,30 @@
 
 namespace pneumo {
 
-namespace {
-constexpr double kMaxIncrementMmHg = 4.0;
-// FIRE parameters (Bitzek 2006 / Guénolé 2020 defaults), in pseudo-time units where ω_max ≤ √2.
-constexpr double kDtMax = 1.0, kDtStart = 0.1, kDtMin = 0.02;
-constexpr int kDelaySteps = 5;
-constexpr double kGrow = 1.1, kShrink = 0.5, kAlphaStart = 0.1, kAlphaShrink = 0.99;
-// Intermediate load increments need only a rough equilibrium.
-constexpr double kIntermediateToleranceFactor = 10.0;
-}  // namespace
+using F = detail::Fire;
 
 SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x) {
   SolveResult r;
   detail::Monitor mon(m, opt, "static", r);
   const int64_t N = m.node_count();
-  // Fictitious masses: the node's spring stiffness sum (plus the volume term's, when on).
-  std::vector<double> mass(N, 0.0);
-  for (std::size_t s = 0; s < m.springs.size(); ++s)
-    for (int32_t n : m.springs[s]) mass[n] += m.spring_k[s];
-  if (opt.forces.volume_stiffness_pa != 0.0)
-    for (std::size_t t = 0; t < m.tets.size(); ++t) {
-      const auto& q = m.tets[t];
-      const auto g = tet_volume_gradient(m.rest_m[q[0]], m.rest_m[q[1]], m.rest_m[q[2]], m.rest_m[q[3]]);
-      for (int i = 0; i < 4; ++i)
-        mass[q[i]] += std::abs(opt.forces.volume_stiffness_pa) * g[i].squaredNorm() / m.tet_rest_volume_m3[t];
-    }
-  for (auto& w : mass) w = w > 0.0 ? w : 1.0;
+  const std::vector<double> mass = detail::fire_masses(m, opt);
 
   ForceEvaluator eval(m);
   ForceModel model = opt.forces;
   model.damping = false;
-  const double target_mmhg = opt.forces.pressure_pa / units::kPaPerMmHg;
-  const int increments = std::max(1, int(std::ceil(std::abs(target_mmhg) / kMaxIncrementMmHg)));
+  const int increments = detail::load_increments(opt);
 
   std::vector<Vec3> v(N, Vec3::Zero()), f;
   int64_t step = 0;
   double residual = INFINITY;
   bool converged = false;
   std::string reason = "step limit";
-  const std::string advice = "the static solver failed to relax this load; check for unattached parts (no fixed nodes)";
+  const std::string advice = detail::kStaticAdvice;
   for (int inc = 1; inc <= increments && step < opt.max_steps; ++inc) {
     model.pressure_pa = opt.forces.pressure_pa * double(inc) / increments;
     const bool last = inc == increments;
-    const double tol = opt.residual_tolerance * (last ? 1.0 : kIntermediateToleranceFactor);
-    double dt = kDtStart, alpha = kAlphaStart;
+    const double tol = opt.residual_tolerance * (last ? 1.0 : F::kIntermediateToleranceFactor);
+    double dt = F::kDtStart, alpha = F::kAlphaStart;
     int positive = 0;
     std::fill(v.begin(), v.end(), Vec3::Zero());
     eval.evaluate(model, x, {}, f);
@@ -68,14 +48,14 @@ SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vecto
       double power = 0.0;
       for (int64_t n = 0; n < N; ++n) power += f[n].dot(v[n]);
       if (power > 0.0) {
-        if (++positive > kDelaySteps) {
-          dt = std::min(dt * kGrow, kDtMax);
-          alpha *= kAlphaShrink;
+        if (++positive > F::kDelaySteps) {
+          dt = std::min(dt * F::kGrow, F::kDtMax);
+          alpha *= F::kAlphaShrink;
         }
       } else {
         positive = 0;
-        dt = std::max(dt * kShrink, kDtMin);
-        alpha = kAlphaStart;
+        dt = std::max(dt * F::kShrink, F::kDtMin);
+        alpha = F::kAlphaStart;
         for (int64_t n = 0; n < N; ++n) x[n] -= 0.5 * dt * v[n];
         std::fill(v.begin(), v.end(), Vec3::Zero());
       }

@@ -30,6 +30,7 @@ struct SolveOptions {
   int newmark_max_inner = 50;
   double kitasaka_step = 0.3;
   double kitasaka_tolerance_m = 1e-3;  // β: Σ|ΔR_i| over all nodes
+  bool kitasaka_jacobi = false;        // CPU reference: all nodes from the same forces, as the device does
   OnInverted on_inverted = OnInverted::Continue;
   int64_t monitor_every = 10;        // convergence/inversion checks every N steps
   bool progress = true;

@@ -8,6 +8,62 @@
 
 namespace pneumo::detail {
 
+std::vector<double> fire_masses(const Mesh& m, const SolveOptions& opt) {
+  std::vector<double> mass = stiffness_sums(m);
+  if (opt.forces.volume_stiffness_pa != 0.0)
+    for (std::size_t t = 0; t < m.tets.size(); ++t) {
+      const auto& q = m.tets[t];
+      const auto g = tet_volume_gradient(m.rest_m[q[0]], m.rest_m[q[1]], m.rest_m[q[2]], m.rest_m[q[3]]);
+      for (int i = 0; i < 4; ++i)
+        mass[q[i]] += std::abs(opt.forces.volume_stiffness_pa) * g[i].squaredNorm() / m.tet_rest_volume_m3[t];
+    }
+  for (auto& w : mass) w = w > 0.0 ? w : 1.0;
+  return mass;
+}
+
+int load_increments(const SolveOptions& opt) {
+  const double target_mmhg = opt.forces.pressure_pa / units::kPaPerMmHg;
+  return std::max(1, int(std::ceil(std::abs(target_mmhg) / Fire::kMaxIncrementMmHg)));
+}
+
+std::vector<double> stiffness_sums(const Mesh& m) {
+  std::vector<double> d(m.node_count(), 0.0);
+  for (std::size_t s = 0; s < m.springs.size(); ++s)
+    for (int32_t n : m.springs[s]) d[n] += m.spring_k[s];
+  return d;
+}
+
+double chosen_dt(const Mesh& m, const SolveOptions& opt, bool damping, SolveResult& r) {
+  r.dt_stable_s = stable_time_step(m, damping);
+  r.dt_s = opt.dt_s > 0.0 ? opt.dt_s : opt.dt_safety * r.dt_stable_s;
+  return r.dt_s;
+}
+
+std::string dt_advice(double dt_s, double dt_stable_s) {
+  std::ostringstream os;
+  os.precision(3);
+  os << "the time step " << dt_s / units::kSecondsPerMs << " ms is too large; set solver.dt_ms "
+     << "below the largest stable step, about " << dt_stable_s / units::kSecondsPerMs << " ms (or 0 for automatic)";
+  return os.str();
+}
+
+double newmark_acceleration_floor(const Mesh& m, const Monitor& mon) {
+  double heaviest = 0.0;
+  for (double mass : m.mass_kg) heaviest = std::max(heaviest, mass);
+  return mon.reference_load() / heaviest;
+}
+
+std::string newmark_failure(int64_t step, double relative_change, int iterations, const SolveOptions& opt, double dt_s,
+                            double dt_stable_s) {
+  std::ostringstream os;
+  os.precision(3);
+  os << "newmark inner loop did not converge at step " << step << " (relative change " << relative_change
+     << " after " << iterations << " iterations, limit " << opt.newmark_inner_tolerance
+     << "): " << dt_advice(dt_s, dt_stable_s)
+     << "; the loop converges only for ωΔt < 2(√(1+ξ²) − ξ), like explicit integration";
+  return os.str();
+}
+
 void apply_holds(const Mesh& m, std::vector<Vec3>& vec) {
   for (int64_t n = 0; n < m.node_count(); ++n) {
     const uint8_t h = m.hold[n];
@@ -58,31 +114,37 @@ double Monitor::max_displacement(const std::vector<Vec3>& x) const {
 }
 
 void Monitor::check_diverged(const std::vector<Vec3>& x, int64_t step, const std::string& advice) const {
-  bool finite = true;
-  double worst = 0.0;
-  for (int64_t n = 0; n < m_.node_count() && finite; ++n) {
-    finite = x[n].allFinite();
-    if (finite) worst = std::max(worst, (x[n] - m_.rest_m[n]).norm());
-  }
-  if (finite && worst <= extent_m_) return;
+  check_diverged(max_displacement(x), step, advice);
+}
+
+void Monitor::check_diverged(double max_displacement_m, int64_t step, const std::string& advice) const {
+  // A non-finite position makes max_displacement_m NaN or infinite: both fail the test below.
+  if (max_displacement_m <= extent_m_) return;
   std::ostringstream os;
   os.precision(3);
   os << r_.solver << " diverged at step " << step << " ("
-     << (finite ? "a node moved " + std::to_string(units::m_to_mm(worst)) + " mm, beyond the model's size"
-                : std::string("non-finite positions"))
+     << (std::isfinite(max_displacement_m)
+             ? "a node moved " + std::to_string(units::m_to_mm(max_displacement_m)) + " mm, beyond the model's size"
+             : std::string("non-finite positions"))
      << "): " << advice;
   throw DivergedError(os.str(), r_.dt_stable_s);
 }
 
 bool Monitor::record(int64_t step, double time_s, double pressure_pa, double residual, const std::vector<Vec3>& x,
                      const std::vector<Vec3>& v) {
+  return record(step, time_s, pressure_pa, residual, max_displacement(x), v.empty() ? 0.0 : max_speed(v),
+                [&]() -> const std::vector<Vec3>& { return x; });
+}
+
+bool Monitor::record(int64_t step, double time_s, double pressure_pa, double residual, double max_displacement_m,
+                     double max_speed_m_s, const std::function<const std::vector<Vec3>&()>& positions) {
   SolveSample s;
   s.step = step;
   s.time_s = time_s;
   s.pressure_pa = pressure_pa;
   s.residual = residual;
-  s.max_displacement_m = max_displacement(x);
-  s.max_speed_m_s = v.empty() ? 0.0 : max_speed(v);
+  s.max_displacement_m = max_displacement_m;
+  s.max_speed_m_s = max_speed_m_s;
   r_.history.push_back(s);
   char detail[160];
   std::snprintf(detail, sizeof detail, "residual %.2e (target %.0e)  P %.1f mmHg  max displacement %.1f mm",
@@ -101,7 +163,7 @@ bool Monitor::record(int64_t step, double time_s, double pressure_pa, double res
   }
   progress_.update(step, detail, eta);
   if (opt_.on_inverted == OnInverted::Stop) {
-    r_.inverted_tetrahedra = count_inverted(m_, x);
+    r_.inverted_tetrahedra = count_inverted(m_, positions());
     return r_.inverted_tetrahedra > 0;
   }
   return false;
@@ -111,11 +173,19 @@ std::string Monitor::check_dynamic(int64_t step, double time_s, double pressure_
                                    const std::vector<Vec3>& x, const std::vector<Vec3>& v, const std::string& advice,
                                    double* residual) {
   if (step % opt_.monitor_every != 0 && step != opt_.max_steps) return "";
-  check_diverged(x, step, advice);
-  *residual = this->residual(f);
-  if (record(step, time_s, pressure_pa, *residual, x, v)) return "inverted tetrahedra";
+  return check_dynamic(step, time_s, pressure_pa, this->residual(f), max_displacement(x), max_speed(v), advice,
+                       [&]() -> const std::vector<Vec3>& { return x; }, residual);
+}
+
+std::string Monitor::check_dynamic(int64_t step, double time_s, double pressure_pa, double residual_now,
+                                   double max_displacement_m, double max_speed_m_s, const std::string& advice,
+                                   const std::function<const std::vector<Vec3>&()>& positions, double* residual) {
+  check_diverged(max_displacement_m, step, advice);
+  *residual = residual_now;
+  if (record(step, time_s, pressure_pa, residual_now, max_displacement_m, max_speed_m_s, positions))
+    return "inverted tetrahedra";
   const bool ramped = time_s >= opt_.ramp_s;
-  const bool still = ramped && *residual < opt_.residual_tolerance && max_speed(v) < opt_.velocity_tolerance_m_s;
+  const bool still = ramped && residual_now < opt_.residual_tolerance && max_speed_m_s < opt_.velocity_tolerance_m_s;
   held_steps_ = still ? held_steps_ + opt_.monitor_every : 0;
   return held_steps_ >= opt_.hold_steps ? "converged" : "";
 }

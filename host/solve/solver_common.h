@@ -2,6 +2,7 @@
 // What every solver shares: holds, the residual and its reference load, divergence checks,
 // the history and progress. Internal to host/solve.
 #include <chrono>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -9,6 +10,40 @@
 #include "solve/solver.h"
 
 namespace pneumo::detail {
+
+class Monitor;
+
+// ---- shared by the CPU reference and the device solvers ----------------------------------------
+
+/// FIRE's parameters (Bitzek 2006 / Guénolé 2020 defaults), in pseudo-time units where ω_max ≤ √2.
+struct Fire {
+  static constexpr double kMaxIncrementMmHg = 4.0;   // load steps of at most this
+  static constexpr double kDtMax = 1.0, kDtStart = 0.1, kDtMin = 0.02;
+  static constexpr int kDelaySteps = 5;
+  static constexpr double kGrow = 1.1, kShrink = 0.5, kAlphaStart = 0.1, kAlphaShrink = 0.99;
+  static constexpr double kIntermediateToleranceFactor = 10.0;   // rough equilibrium between increments
+};
+/// FIRE's fictitious masses: each node's spring stiffness sum (plus the volume term's, when on).
+std::vector<double> fire_masses(const Mesh& m, const SolveOptions& opt);
+/// Number of load increments for the static solver.
+int load_increments(const SolveOptions& opt);
+/// Each node's spring stiffness sum D_i (the 2004 scheme's scaling).
+std::vector<double> stiffness_sums(const Mesh& m);
+/// The time step the dynamic schemes use, recording it and the stable estimate in r.
+double chosen_dt(const Mesh& m, const SolveOptions& opt, bool damping, SolveResult& r);
+/// What to tell the user when a dynamic scheme diverges.
+std::string dt_advice(double dt_s, double dt_stable_s);
+/// Newmark's inner loop measures its change against max(|a|, this floor): the acceleration the
+/// reference load gives the heaviest node (near equilibrium |a| vanishes and rounding would
+/// otherwise look like divergence).
+double newmark_acceleration_floor(const Mesh& m, const Monitor& mon);
+/// The message of a Newmark inner loop that did not converge.
+std::string newmark_failure(int64_t step, double relative_change, int iterations, const SolveOptions& opt, double dt_s,
+                            double dt_stable_s);
+inline const char* kKitasakaAdvice =
+    "solver.kitasaka_step is too large for this mesh; try a smaller value (the paper uses 0.3)";
+inline const char* kStaticAdvice =
+    "the static solver failed to relax this load; check for unattached parts (no fixed nodes)";
 
 /// Zeroes the held world axes of each node (fixed nodes, symmetry planes).
 void apply_holds(const Mesh& m, std::vector<Vec3>& vec);
@@ -23,15 +58,26 @@ class Monitor {
   double max_displacement(const std::vector<Vec3>& x) const;
   /// Throws DivergedError when x holds a non-finite value or moved further than the model's size.
   void check_diverged(const std::vector<Vec3>& x, int64_t step, const std::string& parameter_advice) const;
+  /// The same from the largest displacement (NaN or infinite for non-finite positions).
+  void check_diverged(double max_displacement_m, int64_t step, const std::string& parameter_advice) const;
   /// Records a history row, shows progress; returns true when the run must stop for inversion.
   bool record(int64_t step, double time_s, double pressure_pa, double residual, const std::vector<Vec3>& x,
               const std::vector<Vec3>& v);
+  /// The same from scalars measured elsewhere (a device); `positions` is called only when the
+  /// inversion check needs them.
+  bool record(int64_t step, double time_s, double pressure_pa, double residual, double max_displacement_m,
+              double max_speed_m_s, const std::function<const std::vector<Vec3>&()>& positions);
   /// Every monitor_every steps of a dynamic scheme: checks divergence, records, and counts how long
   /// residual and speed have stayed below their tolerances after the ramp. Returns "" to go on, or
   /// the stop reason ("converged", "inverted tetrahedra"); `residual` is updated when checked.
   std::string check_dynamic(int64_t step, double time_s, double pressure_pa, const std::vector<Vec3>& f,
                             const std::vector<Vec3>& x, const std::vector<Vec3>& v, const std::string& advice,
                             double* residual);
+  /// The same from scalars (the residual already divided by reference_load()); call it only on
+  /// monitoring steps.
+  std::string check_dynamic(int64_t step, double time_s, double pressure_pa, double residual_now,
+                            double max_displacement_m, double max_speed_m_s, const std::string& advice,
+                            const std::function<const std::vector<Vec3>&()>& positions, double* residual);
   void finish(const std::vector<Vec3>& x, const std::vector<Vec3>& v, int64_t steps, int64_t force_evaluations,
               bool converged, const std::string& stop_reason, double residual);
   double reference_load() const { return ref_load_; }

@@ -1,0 +1,524 @@
+// Solver throughput benchmarks: force evaluations per second and node-updates per second (one node advanced by one
+// explicit step, its force evaluation included) on the small, medium and large phantom meshes, for the CPU
+// reference (double, 1 thread and all threads) and every OpenCL device (float32), each with a roofline ratio.
+//
+//   POCL_CACHE_DIR=/tmp/pocl build/bench/pneumo_bench --benchmark_filter='Forces|ExplicitStep'
+//       --benchmark_repetitions=5 --benchmark_report_aggregates_only=true   (one command line)
+//
+// Names: BM_Forces/<device>/<size> and BM_ExplicitStep/<device>/<size>, device = cpu_1thread, cpu_<N>threads
+// (N = all threads OpenMP would use), opencl_<platform>_<device>.
+//
+// Counters (medians over repetitions are what to compare; never a pass/fail on time):
+//   force_evals_per_s      whole-mesh force evaluations per second
+//   node_updates_per_s     BM_ExplicitStep: nodes × steps per second; BM_Forces: nodes × evaluations per second
+//   bytes_per_node_update  the DRAM bytes one node's update must move, counted from the data structures (below);
+//                          for BM_Forces the force evaluation's share only
+//   flops_per_node_update  the floating-point operations of the same
+//   bandwidth_gb_s         STREAM triad measured in this process on the same device with the same threads
+//                          (perf::measure_triad_native / measure_triad_opencl), 1 GB = 1e9 bytes
+//   roofline_fraction      achieved rate / min(bandwidth / bytes, peak / flops): the bound that binds. The label
+//                          says which ("memory-bound" or "compute-bound").
+//   other_cores            CPU (in cores) that other processes used while it ran: the machine is shared, and a run
+//                          with other_cores above ~0.1 is contended (discard it)
+//   nodes, springs, spring_slots   the mesh (spring_slots: the padded neighbour table's width on OpenCL)
+//   working_set_mib        bytes_per_node_update × nodes: below the L3 (32 MiB here) the data can stay in cache
+//                          between passes, and the DRAM-triad roofline is then a conservative bound (a fraction
+//                          above 1 is possible)
+//
+// Peak float32 is assumed 115 GFLOP/s per core (platform.md: ~230 GFLOP/s on the 2-core Zen 4 with float8/16
+// arithmetic), double half of that; per OpenCL device its compute units × that. Set PNEUMO_BENCH_PEAK_GFLOP_S to
+// override the whole device's float32 peak (e.g. for a GPU).
+//
+// Byte counts (every array streamed once per pass; the gathers of neighbours' positions and velocities are counted
+// as cache hits, since neighbours lie within a few lattice planes of the node). A write counts once, as the triad
+// counts it.
+//   OpenCL, node_forces:  x, v (float4 each), mass (float), force write (float4), and the padded slot-major spring
+//                         table: spring_slots × (index, k, c, rest) = 16 B per slot, whole width (neighbouring nodes
+//                         alternate between 6 and 18 springs in the 5-tetrahedron lattice, so every cache line of
+//                         every slot is touched). Pressure on: per triangle its int4 and its force written and read
+//                         back (3 × 16 B), plus per node the first slot of the triangle table and one int per real
+//                         entry. Volume term on: likewise per tetrahedron (int4, rest volume, 4 float4 forces
+//                         written and read) and the tetrahedron table.
+//   OpenCL, integrator:   explicit_step reads x, v, force, the hold mask (float4 each) and 1/m (float), writes x
+//                         and v: 100 B per node.
+//   CPU reference:        double Vec3 (24 B). Per spring: its 2 node ids, k, c, rest length, its force written and
+//                         read back by the gather, 2 adjacency entries; per node: x, v, mass, the adjacency row
+//                         start, the force written; per triangle: ids, force written and read, 3 adjacency
+//                         entries (+ the node's row start). Integrator: reads x, v, f, mass, hold; writes x, v.
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cl/cl_runtime.h"
+#include "core/log.h"
+#include "core/progress.h"
+#include "mesh/adjacency.h"
+#include "mesh/mesh.h"
+#include "perf/bandwidth.h"
+#include "phantom/phantom.h"
+#include "roles/roles.h"
+#include "scene/scene.h"
+#include "solve/forces.h"
+#include "solve/forces_cl.h"
+#include "solve/solver.h"
+#include "solve/solver_cl.h"
+
+using namespace pneumo;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr int kStepsPerIteration = 10;                // explicit steps per timed iteration
+constexpr std::size_t kTriadBytes = 512ull << 20;     // per array, far beyond the 32 MiB L3 (as bench_foundation)
+constexpr int kTriadReps = 5;
+constexpr double kPeakF32PerCore = 115e9;             // platform.md: ~230 GFLOP/s float32 on 2 cores
+constexpr PhantomSize kSizes[] = {PhantomSize::Small, PhantomSize::Medium, PhantomSize::Large};
+
+// ---- the meshes, built once per size as the pipeline builds them -------------------------------
+
+struct MeshCase {
+  Mesh mesh;
+  ForceModel model;      // the scene's: 12 mmHg on the cavity triangles, volume term off
+  double dt_s = 0.0;     // dt_safety × the stability bound, as the explicit solver chooses it
+  std::vector<Vec3> x0, v0;   // a perturbed state: nothing trivially zero
+};
+
+const MeshCase& mesh_case(PhantomSize size) {
+  static std::mutex mutex;
+  static std::map<PhantomSize, std::unique_ptr<MeshCase>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[size];
+  if (slot) return *slot;
+  Progress::set_enabled(false);
+  const log::Level log_level = log::level();
+  log::set_level(log::Level::Quiet);   // the phantom's scene names a few labels its CT lacks: a warning per size
+  const auto t0 = Clock::now();
+  auto c = std::make_unique<MeshCase>();
+  const Scene scene = parse_scene(nlohmann::json::parse(phantom_scene_json(size)), "");
+  {
+    const Phantom ph = make_phantom(size);
+    const RoleVolume rv = assign_roles(scene, ph.ct, &ph.labels);
+    c->mesh = build_scene_mesh(VoxelRoles{rv.geometry, rv.role.data(), rv.label.data()}, scene);
+  }
+  log::set_level(log_level);
+  const SolveOptions opt = solve_options_from_scene(scene);
+  c->model = opt.forces;
+  c->model.volume_stiffness_pa = 0.0;   // the static solver's default; the explicit scheme's too
+  c->dt_s = opt.dt_s > 0 ? opt.dt_s : opt.dt_safety * stable_time_step(c->mesh, c->model.damping);
+  const int64_t N = c->mesh.node_count();
+  c->x0 = c->mesh.rest_m;
+  c->v0.assign(N, Vec3::Zero());
+  for (int64_t n = 0; n < N; ++n) {   // deterministic: ~0.1 mm and ~1 mm/s
+    const double a = std::sin(0.37 * double(n)), b = std::cos(0.61 * double(n)), s = std::sin(0.13 * double(n));
+    c->x0[n] += 1e-4 * Vec3(a, b, s);
+    c->v0[n] = 1e-3 * Vec3(b, s, a);
+  }
+  const MeshStats& st = c->mesh.stats;
+  std::fprintf(stderr, "[bench_solver] %s mesh: %lld nodes, %lld springs, %lld tetrahedra, %lld cavity triangles, "
+                       "dt %.3g ms, pressure %.1f Pa (built in %.1f s)\n",
+               phantom_size_name(size), (long long)st.nodes, (long long)st.springs, (long long)st.tetrahedra,
+               (long long)st.cavity_triangles, c->dt_s * 1e3, c->model.pressure_pa,
+               std::chrono::duration<double>(Clock::now() - t0).count());
+  slot = std::move(c);
+  return *slot;
+}
+
+// ---- the bandwidth, measured once per device (and thread count) in this process -------------------
+
+double native_bandwidth_gb_s(int threads) {
+  static std::mutex mutex;
+  static std::map<int, double> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto it = cache.find(threads);
+  if (it != cache.end()) return it->second;
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(threads);
+  const double gb_s = perf::measure_triad_native(kTriadBytes, kTriadReps).median_gb_s;
+  omp_set_num_threads(before);
+  std::fprintf(stderr, "[bench_solver] triad, native, %d thread(s): %.1f GB/s\n", threads, gb_s);
+  return cache[threads] = gb_s;
+}
+
+// An OpenCL device held for the whole process (Context::shared only caches weakly).
+struct ClDevice {
+  std::shared_ptr<ocl::Context> ctx;
+  double bandwidth_gb_s = 0.0;
+};
+
+ClDevice& cl_device(const ocl::DeviceInfo& info) {
+  static std::mutex mutex;
+  static std::map<std::string, ClDevice> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  ClDevice& d = cache[info.spec()];
+  if (!d.ctx) {
+    d.ctx = ocl::Context::shared(ocl::parse_device_spec(info.spec()));
+    d.bandwidth_gb_s = perf::measure_triad_opencl(*d.ctx, kTriadBytes, kTriadReps).median_gb_s;
+    std::fprintf(stderr, "[bench_solver] triad, %s (%s): %.1f GB/s\n", info.spec().c_str(), info.name.c_str(),
+                 d.bandwidth_gb_s);
+  }
+  return d;
+}
+
+double cl_peak_flop_s(const ocl::DeviceInfo& info) {
+  if (const char* e = std::getenv("PNEUMO_BENCH_PEAK_GFLOP_S")) return std::atof(e) * 1e9;
+  return kPeakF32PerCore * std::max(1u, info.compute_units);
+}
+
+// ---- bytes and FLOPs per node-update, from the data structures --------------------------------
+
+struct Cost {
+  double bytes = 0.0, flops = 0.0;   // per node
+};
+
+/// Σ over nodes of min(degree + 1, slots): the entries a per-node loop over a padded table reads before its −1.
+double table_reads(const Csr& c, int64_t nodes, int64_t slots) {
+  double r = 0.0;
+  for (int64_t n = 0; n < nodes; ++n) r += double(std::min<int64_t>(c.end(n) - c.begin(n) + 1, slots));
+  return r;
+}
+int64_t max_degree(const Csr& c, int64_t nodes) {
+  int64_t d = 1;
+  for (int64_t n = 0; n < nodes; ++n) d = std::max(d, c.end(n) - c.begin(n));
+  return d;
+}
+
+// FLOPs of one spring end in node_forces (nonlinear, damped): d, dv (6), length (6), dir (3), elastic part (5),
+// damper (9), sum into f (6).
+constexpr double kFlopsSpringEndCl = 35;
+// CPU reference: one evaluation per spring (the same 29 without the sum), then ± gathered at both ends (3 each).
+constexpr double kFlopsSpringCpu = 29 + 6;
+constexpr double kFlopsTriangle = 24 + 9;       // area normal, scaled; gathered at its 3 vertices
+constexpr double kFlopsTet = 74 + 12;           // 3 cross products, volume, scale; gathered at 4 vertices
+constexpr double kFlopsGravity = 3;
+constexpr double kFlopsIntegrator = 13;         // dt/m, v += (dt/m) f, x += dt v
+
+Cost cl_force_cost(const Mesh& m, const ForceModel& model, int spring_slots) {
+  const Adjacency a = Adjacency::of(m);
+  const double N = double(m.node_count()), S = double(m.springs.size()), R = double(m.cavity_tris.size()),
+               T = double(m.tets.size());
+  Cost c;
+  double bytes = N * (16 + 16 + 4 + 16) + N * double(spring_slots) * 16;
+  double flops = 2 * S * kFlopsSpringEndCl + N * kFlopsGravity;
+  if (model.pressure_pa != 0.0 && R > 0) {
+    bytes += R * 3 * 16 + 4 * table_reads(a.tris, m.node_count(), max_degree(a.tris, m.node_count()));
+    flops += R * kFlopsTriangle;
+  }
+  if (model.volume_stiffness_pa != 0.0 && T > 0) {
+    bytes += T * (16 + 4 + 2 * 64) + 4 * table_reads(a.tets, m.node_count(), max_degree(a.tets, m.node_count()));
+    flops += T * kFlopsTet;
+  }
+  c.bytes = bytes / N;
+  c.flops = flops / N;
+  return c;
+}
+constexpr double kClIntegratorBytes = 3 * 16 + 4 + 16 + 2 * 16;   // x, v, f, 1/m, hold mask; x, v
+constexpr double kFlopsIntegratorCl = kFlopsIntegrator + 3;            // the hold mask's multiply
+
+Cost cpu_force_cost(const Mesh& m, const ForceModel& model) {
+  const double N = double(m.node_count()), S = double(m.springs.size()), R = double(m.cavity_tris.size()),
+               T = double(m.tets.size());
+  double bytes = N * (24 + 24 + 8 + 8 + 24) + S * (8 + 3 * 8 + 24 + 24 + 2 * 4);
+  double flops = S * kFlopsSpringCpu + N * kFlopsGravity;
+  if (model.pressure_pa != 0.0 && R > 0) {
+    bytes += R * (12 + 24 + 24 + 3 * 4) + N * 8;
+    flops += R * kFlopsTriangle;
+  }
+  if (model.volume_stiffness_pa != 0.0 && T > 0) {
+    bytes += T * (16 + 8 + 2 * 96 + 4 * 4) + N * 8;
+    flops += T * kFlopsTet;
+  }
+  return Cost{bytes / N, flops / N};
+}
+constexpr double kCpuIntegratorBytes = 3 * 24 + 8 + 1 + 2 * 24;
+
+/// Sets the roofline counters from the achieved node rate (node-updates or node force evaluations per second).
+void report_roofline(benchmark::State& state, const Mesh& m, const Cost& cost, double node_rate,
+                     double bandwidth_gb_s, double peak_flop_s, const std::string& device_label) {
+  const double mem_bound = bandwidth_gb_s * 1e9 / cost.bytes;
+  const double flop_bound = peak_flop_s / cost.flops;
+  const bool memory = mem_bound <= flop_bound;
+  state.counters["bytes_per_node_update"] = cost.bytes;
+  state.counters["flops_per_node_update"] = cost.flops;
+  state.counters["bandwidth_gb_s"] = bandwidth_gb_s;
+  state.counters["roofline_fraction"] = node_rate / std::min(mem_bound, flop_bound);
+  state.counters["working_set_mib"] = cost.bytes * double(m.node_count()) / double(1 << 20);
+  state.SetLabel(device_label + (memory ? ", memory-bound" : ", compute-bound"));
+}
+
+void mesh_counters(benchmark::State& state, const Mesh& m) {
+  state.counters["nodes"] = double(m.node_count());
+  state.counters["springs"] = double(m.springs.size());
+}
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// ---- contention: CPU used by other processes while a benchmark ran (Linux /proc; −1 elsewhere) ----
+
+struct CpuSample {
+  double busy_s = -1.0, own_s = -1.0;   // all CPUs' busy time; this process's (all its threads, PoCL's included)
+  Clock::time_point t = Clock::now();
+};
+
+CpuSample cpu_sample() {
+  CpuSample s;
+  const double tick = double(::sysconf(_SC_CLK_TCK));
+  if (std::FILE* f = std::fopen("/proc/stat", "r")) {
+    unsigned long long user, nice, system, idle, iowait, irq, softirq;
+    if (std::fscanf(f, "cpu %llu %llu %llu %llu %llu %llu %llu", &user, &nice, &system, &idle, &iowait, &irq,
+                    &softirq) == 7)
+      s.busy_s = double(user + nice + system + irq + softirq) / tick;
+    std::fclose(f);
+  }
+  if (std::FILE* f = std::fopen("/proc/self/stat", "r")) {
+    char buf[1024];
+    const std::size_t len = std::fread(buf, 1, sizeof buf - 1, f);
+    buf[len] = 0;
+    std::fclose(f);
+    // Fields after the command name (which may hold spaces): state is field 3, utime 14, stime 15.
+    if (const char* p = std::strrchr(buf, ')')) {
+      unsigned long long utime = 0, stime = 0;
+      if (std::sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &utime, &stime) == 2)
+        s.own_s = double(utime + stime) / tick;
+    }
+  }
+  return s;
+}
+
+/// Cores' worth of CPU that other processes used between a and b (e.g. 0.9: another job held a core).
+void report_other_cores(benchmark::State& state, const CpuSample& a, const CpuSample& b) {
+  const double wall = std::chrono::duration<double>(b.t - a.t).count();
+  if (a.busy_s < 0 || a.own_s < 0 || b.busy_s < 0 || b.own_s < 0 || wall <= 0) {
+    state.counters["other_cores"] = -1.0;
+    return;
+  }
+  state.counters["other_cores"] = std::max(0.0, ((b.busy_s - a.busy_s) - (b.own_s - a.own_s)) / wall);
+}
+
+/// Runs `fn` with OpenMP limited to `threads`, restoring the previous limit after.
+template <class F>
+void with_threads(int threads, F&& fn) {
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(threads);
+  fn();
+  omp_set_num_threads(before);
+}
+
+// ---- CPU reference ------------------------------------------------------------------------------
+
+void BM_ForcesCpu(benchmark::State& state, PhantomSize size, int threads) {
+  const MeshCase& mc = mesh_case(size);
+  const double bw = native_bandwidth_gb_s(threads);
+  const Mesh& m = mc.mesh;
+  ForceEvaluator eval(m);
+  std::vector<Vec3> f;
+  double seconds = 0.0;
+  with_threads(threads, [&] {
+    eval.evaluate(mc.model, mc.x0, mc.v0, f);   // allocates the per-element scratch
+    const CpuSample c0 = cpu_sample();
+    const auto t0 = Clock::now();
+    for (auto _ : state) {
+      eval.evaluate(mc.model, mc.x0, mc.v0, f);
+      benchmark::DoNotOptimize(f.data());
+      benchmark::ClobberMemory();
+    }
+    seconds = seconds_since(t0);
+    report_other_cores(state, c0, cpu_sample());
+  });
+  const double evals = double(state.iterations()), N = double(m.node_count());
+  state.counters["force_evals_per_s"] = benchmark::Counter(evals, benchmark::Counter::kIsRate);
+  state.counters["node_updates_per_s"] = benchmark::Counter(evals * N, benchmark::Counter::kIsRate);
+  mesh_counters(state, m);
+  report_roofline(state, m, cpu_force_cost(m, mc.model), evals * N / seconds, bw, 0.5 * kPeakF32PerCore * threads,
+                  "CPU reference, double, " + std::to_string(threads) + " thread(s)");
+}
+
+void BM_ExplicitStepCpu(benchmark::State& state, PhantomSize size, int threads) {
+  const MeshCase& mc = mesh_case(size);
+  const double bw = native_bandwidth_gb_s(threads);
+  const Mesh& m = mc.mesh;
+  const int64_t N = m.node_count();
+  ForceEvaluator eval(m);
+  std::vector<Vec3> x = mc.x0, v = mc.v0, f;
+  const double dt = mc.dt_s;
+  // The plain symplectic Euler update of solve_explicit (v += dt f/m, held axes zeroed, x += dt v), one pass.
+  const auto step = [&] {
+    eval.evaluate(mc.model, x, v, f);
+#pragma omp parallel for schedule(static)
+    for (int64_t n = 0; n < N; ++n) {
+      Vec3 vn = v[n] + (dt / m.mass_kg[n]) * f[n];
+      if (const uint8_t h = m.hold[n])
+        for (int a = 0; a < 3; ++a)
+          if (h & (1 << a)) vn[a] = 0.0;
+      v[n] = vn;
+      x[n] += dt * vn;
+    }
+  };
+  double seconds = 0.0;
+  with_threads(threads, [&] {
+    step();
+    const CpuSample c0 = cpu_sample();
+    const auto t0 = Clock::now();
+    for (auto _ : state) {
+      for (int s = 0; s < kStepsPerIteration; ++s) step();
+      benchmark::DoNotOptimize(x.data());
+      benchmark::ClobberMemory();
+    }
+    seconds = seconds_since(t0);
+    report_other_cores(state, c0, cpu_sample());
+  });
+  for (int64_t n = 0; n < N; ++n)
+    if (!x[n].allFinite()) {
+      state.SkipWithError("the explicit steps diverged (non-finite positions)");
+      return;
+    }
+  const double steps = double(state.iterations()) * kStepsPerIteration;
+  state.counters["force_evals_per_s"] = benchmark::Counter(steps, benchmark::Counter::kIsRate);
+  state.counters["node_updates_per_s"] = benchmark::Counter(steps * double(N), benchmark::Counter::kIsRate);
+  mesh_counters(state, m);
+  Cost cost = cpu_force_cost(m, mc.model);
+  cost.bytes += kCpuIntegratorBytes;
+  cost.flops += kFlopsIntegrator;
+  report_roofline(state, m, cost, steps * double(N) / seconds, bw, 0.5 * kPeakF32PerCore * threads,
+                  "CPU reference, double, " + std::to_string(threads) + " thread(s)");
+}
+
+// ---- OpenCL -------------------------------------------------------------------------------------
+
+/// The device's force evaluator for a size, uploaded once.
+ClForceEvaluator& cl_forces(ClDevice& dev, const ocl::DeviceInfo& info, PhantomSize size) {
+  static std::mutex mutex;
+  static std::map<std::pair<std::string, PhantomSize>, std::unique_ptr<ClForceEvaluator>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[{info.spec(), size}];
+  if (!slot) {
+    const MeshCase& mc = mesh_case(size);
+    slot = std::make_unique<ClForceEvaluator>(*dev.ctx, mc.mesh);
+    slot->upload_state(mc.x0, mc.v0);
+  }
+  return *slot;
+}
+
+void BM_ForcesCl(benchmark::State& state, PhantomSize size, ocl::DeviceInfo info) {
+  try {
+    const MeshCase& mc = mesh_case(size);
+    ClDevice& dev = cl_device(info);
+    ClForceEvaluator& eval = cl_forces(dev, info, size);
+    auto& q = dev.ctx->queue();
+    for (int w = 0; w < 2; ++w) eval.evaluate(mc.model);   // the first launch of each kernel compiles on PoCL
+    q.finish();
+    const CpuSample c0 = cpu_sample();
+    const auto t0 = Clock::now();
+    for (auto _ : state) {
+      eval.evaluate(mc.model);
+      q.finish();
+    }
+    const double seconds = seconds_since(t0);
+    report_other_cores(state, c0, cpu_sample());
+    const double evals = double(state.iterations()), N = double(mc.mesh.node_count());
+    state.counters["force_evals_per_s"] = benchmark::Counter(evals, benchmark::Counter::kIsRate);
+    state.counters["node_updates_per_s"] = benchmark::Counter(evals * N, benchmark::Counter::kIsRate);
+    state.counters["spring_slots"] = eval.spring_slots();
+    mesh_counters(state, mc.mesh);
+    report_roofline(state, mc.mesh, cl_force_cost(mc.mesh, mc.model, eval.spring_slots()), evals * N / seconds,
+                    dev.bandwidth_gb_s, cl_peak_flop_s(info), info.name + ", float32");
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+  }
+}
+
+void BM_ExplicitStepCl(benchmark::State& state, PhantomSize size, ocl::DeviceInfo info) {
+  try {
+    const MeshCase& mc = mesh_case(size);
+    ClDevice& dev = cl_device(info);
+    // The stepper keeps its state on the device across calls of this function (the dynamics stay bounded: damped,
+    // dt at half the stability limit).
+    static std::mutex mutex;
+    static std::map<std::pair<std::string, PhantomSize>, std::unique_ptr<ClExplicitStepper>> cache;
+    ClExplicitStepper* stepper;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      auto& slot = cache[{info.spec(), size}];
+      if (!slot) slot = std::make_unique<ClExplicitStepper>(*dev.ctx, mc.mesh, mc.model, mc.dt_s);
+      stepper = slot.get();
+    }
+    const int spring_slots = cl_forces(dev, info, size).spring_slots();   // the same tables the stepper builds
+    stepper->steps(2);   // warm every kernel (PoCL compiles at the first launch)
+    stepper->finish();
+    const CpuSample c0 = cpu_sample();
+    const auto t0 = Clock::now();
+    for (auto _ : state) {
+      stepper->steps(kStepsPerIteration);
+      stepper->finish();
+    }
+    const double seconds = seconds_since(t0);
+    report_other_cores(state, c0, cpu_sample());
+    const double steps = double(state.iterations()) * kStepsPerIteration, N = double(mc.mesh.node_count());
+    state.counters["force_evals_per_s"] = benchmark::Counter(steps, benchmark::Counter::kIsRate);
+    state.counters["node_updates_per_s"] = benchmark::Counter(steps * N, benchmark::Counter::kIsRate);
+    state.counters["spring_slots"] = spring_slots;
+    mesh_counters(state, mc.mesh);
+    Cost cost = cl_force_cost(mc.mesh, mc.model, spring_slots);
+    cost.bytes += kClIntegratorBytes;
+    cost.flops += kFlopsIntegratorCl;
+    report_roofline(state, mc.mesh, cost, steps * N / seconds, dev.bandwidth_gb_s, cl_peak_flop_s(info),
+                    info.name + ", float32");
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+  }
+}
+
+// ---- registration -------------------------------------------------------------------------------
+
+bool register_all() {
+  const int all_threads = omp_get_max_threads();
+  std::vector<std::pair<std::string, int>> cpu = {{"cpu_1thread", 1}};
+  if (all_threads > 1) cpu.push_back({"cpu_" + std::to_string(all_threads) + "threads", all_threads});
+  std::vector<ocl::DeviceInfo> devices;
+  try {
+    devices = ocl::list_devices();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "[bench_solver] OpenCL: %s\n", e.what());
+  }
+  if (devices.empty()) std::fprintf(stderr, "[bench_solver] %s\n", ocl::no_device_hint().c_str());
+  const auto cl_name = [](const ocl::DeviceInfo& d) {
+    return "opencl_" + std::to_string(d.platform_index) + "_" + std::to_string(d.device_index);
+  };
+  const auto finish = [](benchmark::internal::Benchmark* b) { b->UseRealTime()->Unit(benchmark::kMillisecond); };
+  for (const PhantomSize size : kSizes) {
+    const std::string sz = phantom_size_name(size);
+    for (const auto& [name, threads] : cpu)
+      finish(benchmark::RegisterBenchmark(("BM_Forces/" + name + "/" + sz).c_str(), BM_ForcesCpu, size, threads));
+    for (const auto& d : devices)
+      finish(benchmark::RegisterBenchmark(("BM_Forces/" + cl_name(d) + "/" + sz).c_str(), BM_ForcesCl, size, d));
+  }
+  for (const PhantomSize size : kSizes) {
+    const std::string sz = phantom_size_name(size);
+    for (const auto& [name, threads] : cpu)
+      finish(benchmark::RegisterBenchmark(("BM_ExplicitStep/" + name + "/" + sz).c_str(), BM_ExplicitStepCpu, size,
+                                          threads));
+    for (const auto& d : devices)
+      finish(benchmark::RegisterBenchmark(("BM_ExplicitStep/" + cl_name(d) + "/" + sz).c_str(), BM_ExplicitStepCl,
+                                          size, d));
+  }
+  return true;
+}
+
+[[maybe_unused]] const bool registered = register_all();
+
+}  // namespace

@@ -1,0 +1,349 @@
+// The four solvers on an OpenCL device: the same loops as the CPU reference (solve_*.cpp), with the
+// state resident on the device and only convergence scalars read back.
+#include "solve/solver_cl.h"
+
+#include <cmath>
+
+#include "core/units.h"
+#include "solve/forces_cl.h"
+#include "solve/solver_common.h"
+
+namespace pneumo {
+
+namespace {
+
+constexpr std::size_t kLocal = 64;   // LOCAL_SIZE of kernels/msd_integrators.cl
+
+template <class... A>
+void set_args(cl::Kernel& k, const A&... a) {
+  cl_uint i = 0;
+  (k.setArg(i++, a), ...);
+}
+
+/// What a device solver holds: the force evaluator (positions, velocities, forces), the per-node
+/// constants of the integrators, and the reduction buffer.
+struct Device {
+  Device(ocl::Context& ctx, const Mesh& m, const std::vector<double>& mass)
+      : ctx(ctx), m(m), n(cl_int(m.node_count())), eval(ctx, m),
+        global((std::size_t(n) + kLocal - 1) / kLocal * kLocal), groups(global / kLocal), partial_host(groups) {
+    std::vector<float> inv(n);
+    std::vector<cl_float4> mask(n);
+    for (int64_t i = 0; i < n; ++i) {
+      inv[i] = mass[i] > 0.0 ? float(1.0 / mass[i]) : 0.0f;
+      const uint8_t h = m.hold[i];
+      mask[i] = {{h & kHoldX ? 0.f : 1.f, h & kHoldY ? 0.f : 1.f, h & kHoldZ ? 0.f : 1.f, 0.f}};
+    }
+    inv_mass = buffer(inv);
+    hold = buffer(mask);
+    partial = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, groups * sizeof(cl_float4));
+    k_monitor = kernel("monitor");
+  }
+  template <class T>
+  cl::Buffer buffer(const std::vector<T>& v) {
+    cl::Buffer b(ctx.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(v.size(), 1) * sizeof(T));
+    if (!v.empty()) ctx.queue().enqueueWriteBuffer(b, CL_TRUE, 0, v.size() * sizeof(T), v.data());
+    return b;
+  }
+  cl::Buffer zeros4() {
+    cl::Buffer b(ctx.context(), CL_MEM_READ_WRITE, std::size_t(n) * sizeof(cl_float4));
+    ctx.queue().enqueueFillBuffer(b, cl_float4{{0, 0, 0, 0}}, 0, std::size_t(n) * sizeof(cl_float4));
+    return b;
+  }
+  cl::Kernel kernel(const char* name) { return ctx.kernel("msd_integrators.cl", name); }
+  void run(cl::Kernel& k) {
+    ctx.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(global), cl::NDRange(kLocal));
+  }
+  /// Runs a reduction kernel and combines its groups in order: component-wise max or sum.
+  std::array<double, 4> reduce(cl::Kernel& k, bool sum) {
+    run(k);
+    ctx.queue().enqueueReadBuffer(partial, CL_TRUE, 0, groups * sizeof(cl_float4), partial_host.data());
+    std::array<double, 4> r{0, 0, 0, 0};
+    for (const auto& p : partial_host)
+      for (int c = 0; c < 4; ++c) {
+        const double v = p.s[c];
+        r[c] = sum ? r[c] + v : (std::isnan(v) || v > r[c] ? v : r[c]);
+      }
+    return r;
+  }
+  struct Observation { double max_free_force, max_speed, max_displacement; };
+  Observation observe(cl::Buffer& x, cl::Buffer& v) {
+    set_args(k_monitor, eval.forces(), v, x, hold, n, partial);
+    const auto r = reduce(k_monitor, false);
+    return {r[0], r[1], r[2]};
+  }
+  std::vector<Vec3> download(cl::Buffer& b) {
+    std::vector<cl_float4> raw(n);
+    ctx.queue().enqueueReadBuffer(b, CL_TRUE, 0, std::size_t(n) * sizeof(cl_float4), raw.data());
+    std::vector<Vec3> out(n);
+    for (int64_t i = 0; i < n; ++i) out[i] = Vec3(raw[i].s[0], raw[i].s[1], raw[i].s[2]);
+    return out;
+  }
+
+  ocl::Context& ctx;
+  const Mesh& m;
+  cl_int n;
+  ClForceEvaluator eval;
+  std::size_t global, groups;
+  cl::Buffer inv_mass, hold, partial;
+  std::vector<cl_float4> partial_host;
+  cl::Kernel k_monitor;
+};
+
+/// Positions fetched from the device only when the inversion check asks for them.
+auto lazy_positions(Device& d, cl::Buffer& x, std::vector<Vec3>& cache) {
+  return [&d, &x, &cache]() -> const std::vector<Vec3>& {
+    cache = d.eval.download_positions(x);
+    return cache;
+  };
+}
+
+SolveResult explicit_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x0) {
+  SolveResult r;
+  detail::Monitor mon(m, opt, "explicit", r);
+  const double dt = detail::chosen_dt(m, opt, opt.forces.damping, r);
+  Device d(ctx, m, m.mass_kg);
+  d.eval.upload_state(x0, std::vector<Vec3>(x0.size(), Vec3::Zero()));
+  cl::Kernel step_k = d.kernel("explicit_step");
+  set_args(step_k, d.eval.positions(), d.eval.velocities(), d.eval.forces(), d.inv_mass, d.hold, float(dt), d.n);
+  ForceModel model = opt.forces;
+  std::vector<Vec3> cache;
+  int64_t step = 0;
+  double residual = INFINITY;
+  std::string reason;
+  while (step < opt.max_steps) {
+    const double t = step * dt;
+    model.pressure_pa = opt.forces.pressure_pa * ramp_factor(t, opt.ramp_s, opt.ramp_shape);
+    d.eval.evaluate(model);
+    d.run(step_k);
+    ++step;
+    if (step % opt.monitor_every != 0 && step != opt.max_steps) continue;
+    const auto o = d.observe(d.eval.positions(), d.eval.velocities());
+    reason = mon.check_dynamic(step, t + dt, model.pressure_pa, o.max_free_force / mon.reference_load(),
+                               o.max_displacement, o.max_speed, detail::dt_advice(dt, r.dt_stable_s),
+                               lazy_positions(d, d.eval.positions(), cache), &residual);
+    if (!reason.empty()) break;
+  }
+  r.final_pressure_pa = model.pressure_pa;
+  mon.finish(d.eval.download_positions(d.eval.positions()), d.download(d.eval.velocities()), step, step, reason == "converged",
+             reason.empty() ? "step limit" : reason, residual);
+  return r;
+}
+
+SolveResult newmark_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x0) {
+  SolveResult r;
+  detail::Monitor mon(m, opt, "newmark", r);
+  const double dt = detail::chosen_dt(m, opt, opt.forces.damping, r);
+  const float beta = float(opt.newmark_beta), gamma = float(opt.newmark_gamma);
+  const double a_floor = detail::newmark_acceleration_floor(m, mon);
+  // float32 cannot resolve a relative change below its noise floor, which depends on how much the
+  // forces cancel (typically 1e-6..1e-4 of max |a|). The loop therefore also ends when the change has
+  // stopped falling (3 iterations), or the iterations run out, while below kNoiseFloorBound: the floor
+  // is reached, not a divergence (a diverging fixed-point iteration grows far past it).
+  const double inner_tolerance = opt.newmark_inner_tolerance;
+  constexpr double kNoiseFloorBound = 1e-3;
+  Device d(ctx, m, m.mass_kg);
+  d.eval.upload_state(x0, {});
+  cl::Buffer x = d.zeros4(), v = d.zeros4();
+  ctx.queue().enqueueCopyBuffer(d.eval.positions(), x, 0, 0, std::size_t(d.n) * sizeof(cl_float4));
+  cl::Buffer a = d.zeros4(), xp = d.zeros4(), vp = d.zeros4();
+  cl::Kernel predict = d.kernel("newmark_predict"), trial = d.kernel("newmark_trial"),
+             accel = d.kernel("newmark_accel"), commit = d.kernel("newmark_trial");
+  set_args(predict, x, v, a, xp, vp, float(dt), beta, gamma, d.n);
+  set_args(trial, xp, vp, a, d.hold, d.eval.positions(), d.eval.velocities(), float(dt), beta, gamma, d.n);
+  set_args(accel, d.eval.forces(), d.inv_mass, d.hold, a, d.n, d.partial);
+  set_args(commit, xp, vp, a, d.hold, x, v, float(dt), beta, gamma, d.n);
+  ForceModel model = opt.forces;
+  std::vector<Vec3> cache;
+  int64_t step = 0, evaluations = 0;
+  double residual = INFINITY;
+  std::string reason;
+  while (step < opt.max_steps) {
+    const double t_next = (step + 1) * dt;
+    model.pressure_pa = opt.forces.pressure_pa * ramp_factor(t_next, opt.ramp_s, opt.ramp_shape);
+    d.run(predict);
+    double change = INFINITY, previous_change = INFINITY, scale = a_floor;
+    int growing = 0, k = 0;
+    bool at_floor = false;
+    for (; k < opt.newmark_max_inner; ++k) {
+      d.run(trial);
+      d.eval.evaluate(model);
+      ++evaluations;
+      const auto red = d.reduce(accel, false);
+      change = red[0];
+      scale = std::max(red[1], a_floor);
+      ++r.inner_iterations;
+      if (!std::isfinite(change)) break;
+      if (change <= inner_tolerance * scale) break;
+      growing = change >= previous_change ? growing + 1 : 0;
+      if (growing >= 3) break;
+      previous_change = change;
+    }
+    at_floor = std::isfinite(change) && change <= kNoiseFloorBound * scale;
+    if (!std::isfinite(change) || (change > inner_tolerance * scale && !at_floor))
+      throw DivergedError(detail::newmark_failure(step + 1, change / scale, k + 1, opt, dt, r.dt_stable_s),
+                          r.dt_stable_s);
+    d.run(commit);
+    ++step;
+    if (step % opt.monitor_every != 0 && step != opt.max_steps) continue;
+    const auto o = d.observe(x, v);
+    reason = mon.check_dynamic(step, t_next, model.pressure_pa, o.max_free_force / mon.reference_load(),
+                               o.max_displacement, o.max_speed, detail::dt_advice(dt, r.dt_stable_s),
+                               lazy_positions(d, x, cache), &residual);
+    if (!reason.empty()) break;
+  }
+  r.final_pressure_pa = model.pressure_pa;
+  mon.finish(d.eval.download_positions(x), d.download(v), step, evaluations, reason == "converged",
+             reason.empty() ? "step limit" : reason, residual);
+  return r;
+}
+
+SolveResult kitasaka_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x0) {
+  SolveResult r;
+  detail::Monitor mon(m, opt, "kitasaka2004", r);
+  Device d(ctx, m, detail::stiffness_sums(m));   // inv_mass holds 1/D_i here
+  d.eval.upload_state(x0, {});
+  cl::Kernel step_k = d.kernel("kitasaka_step");
+  set_args(step_k, d.eval.positions(), d.eval.forces(), d.inv_mass, d.hold, float(opt.kitasaka_step), d.n, d.partial);
+  ForceModel model = opt.forces;
+  model.damping = false;
+  std::vector<Vec3> cache;
+  int64_t step = 0, evaluations = 0;
+  double residual = INFINITY;
+  std::string reason;
+  while (step < opt.max_steps) {
+    d.eval.evaluate(model);
+    ++evaluations;
+    const double moved = d.reduce(step_k, true)[0];
+    ++step;
+    const bool done = moved < opt.kitasaka_tolerance_m;
+    if (!done && step % opt.monitor_every != 0 && step != opt.max_steps) continue;
+    d.eval.evaluate(model);   // forces at the new positions, for the residual
+    ++evaluations;
+    const auto o = d.observe(d.eval.positions(), d.eval.velocities());
+    mon.check_diverged(o.max_displacement, step, detail::kKitasakaAdvice);
+    residual = o.max_free_force / mon.reference_load();
+    if (mon.record(step, 0.0, model.pressure_pa, residual, o.max_displacement, 0.0,
+                   lazy_positions(d, d.eval.positions(), cache))) {
+      reason = "inverted tetrahedra";
+      break;
+    }
+    if (done) { reason = "converged"; break; }
+  }
+  r.final_pressure_pa = model.pressure_pa;
+  mon.finish(d.eval.download_positions(d.eval.positions()), {}, step, evaluations, reason == "converged",
+             reason.empty() ? "step limit" : reason, residual);
+  return r;
+}
+
+SolveResult static_fire_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x0) {
+  using F = detail::Fire;
+  SolveResult r;
+  detail::Monitor mon(m, opt, "static", r);
+  Device d(ctx, m, detail::fire_masses(m, opt));
+  d.eval.upload_state(x0, std::vector<Vec3>(x0.size(), Vec3::Zero()));
+  cl::Buffer &x = d.eval.positions(), &v = d.eval.velocities(), &f = d.eval.forces();
+  cl::Kernel mask = d.kernel("mask_forces"), sums = d.kernel("fire_sums"), restart = d.kernel("fire_restart"),
+             velocity = d.kernel("fire_velocity"), move = d.kernel("fire_mix_move");
+  set_args(mask, f, d.hold, d.n);
+  set_args(sums, f, v, d.n, d.partial);
+  ForceModel model = opt.forces;
+  model.damping = false;
+  const int increments = detail::load_increments(opt);
+  std::vector<Vec3> cache;
+  int64_t step = 0, evaluations = 0;
+  double residual = INFINITY;
+  std::string reason;
+  auto evaluate = [&] {
+    d.eval.evaluate(model);
+    d.run(mask);
+    ++evaluations;
+  };
+  for (int inc = 1; inc <= increments && step < opt.max_steps; ++inc) {
+    model.pressure_pa = opt.forces.pressure_pa * double(inc) / increments;
+    const bool last = inc == increments;
+    const double tol = opt.residual_tolerance * (last ? 1.0 : F::kIntermediateToleranceFactor);
+    double dt = F::kDtStart, alpha = F::kAlphaStart;
+    int positive = 0;
+    ctx.queue().enqueueFillBuffer(v, cl_float4{{0, 0, 0, 0}}, 0, std::size_t(d.n) * sizeof(cl_float4));
+    evaluate();
+    bool increment_done = false;
+    while (step < opt.max_steps) {
+      const double power = d.reduce(sums, true)[0];
+      if (power > 0.0) {
+        if (++positive > F::kDelaySteps) {
+          dt = std::min(dt * F::kGrow, F::kDtMax);
+          alpha *= F::kAlphaShrink;
+        }
+      } else {
+        positive = 0;
+        dt = std::max(dt * F::kShrink, F::kDtMin);
+        alpha = F::kAlphaStart;
+        set_args(restart, x, v, float(dt), d.n);
+        d.run(restart);
+      }
+      set_args(velocity, v, f, d.inv_mass, float(dt), d.n);
+      d.run(velocity);
+      double v_over_f = 0.0;
+      if (power > 0.0) {
+        const auto s = d.reduce(sums, true);
+        if (s[2] > 0.0) v_over_f = std::sqrt(s[1]) / std::sqrt(s[2]);
+      }
+      set_args(move, x, v, f, float(alpha), float(v_over_f), cl_int(power > 0.0 && v_over_f > 0.0), float(dt), d.n);
+      d.run(move);
+      evaluate();
+      ++step;
+      if (step % opt.monitor_every != 0 && step != opt.max_steps) continue;
+      const auto o = d.observe(x, v);
+      mon.check_diverged(o.max_displacement, step, detail::kStaticAdvice);
+      residual = o.max_free_force / mon.reference_load();
+      if (mon.record(step, 0.0, model.pressure_pa, residual, o.max_displacement, 0.0, lazy_positions(d, x, cache))) {
+        reason = "inverted tetrahedra";
+        break;
+      }
+      if (residual < tol) { increment_done = true; break; }
+    }
+    if (!reason.empty()) break;
+    if (last && increment_done) reason = "converged";
+    if (!increment_done) break;
+  }
+  r.final_pressure_pa = model.pressure_pa;
+  mon.finish(d.eval.download_positions(x), {}, step, evaluations, reason == "converged", reason.empty() ? "step limit" : reason,
+             residual);
+  return r;
+}
+
+}  // namespace
+
+SolveResult solve_opencl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x_start) {
+  const std::vector<Vec3>& x0 = x_start.empty() ? m.rest_m : x_start;
+  switch (opt.method) {
+    case SolverMethod::Explicit: return explicit_cl(ctx, m, opt, x0);
+    case SolverMethod::Newmark: return newmark_cl(ctx, m, opt, x0);
+    case SolverMethod::Kitasaka2004: return kitasaka_cl(ctx, m, opt, x0);
+    case SolverMethod::Static: return static_fire_cl(ctx, m, opt, x0);
+  }
+  throw std::logic_error("unknown solver");
+}
+
+struct ClExplicitStepper::Impl {
+  Impl(ocl::Context& ctx, const Mesh& m, const ForceModel& model, double dt)
+      : d(ctx, m, m.mass_kg), model(model), step_k(d.kernel("explicit_step")) {
+    set_args(step_k, d.eval.positions(), d.eval.velocities(), d.eval.forces(), d.inv_mass, d.hold, float(dt), d.n);
+  }
+  Device d;
+  ForceModel model;
+  cl::Kernel step_k;
+};
+
+ClExplicitStepper::ClExplicitStepper(ocl::Context& ctx, const Mesh& m, const ForceModel& model, double dt_s)
+    : impl_(new Impl(ctx, m, model, dt_s)) {}
+ClExplicitStepper::~ClExplicitStepper() { delete impl_; }
+void ClExplicitStepper::steps(int n) {
+  for (int i = 0; i < n; ++i) {
+    impl_->d.eval.evaluate(impl_->model);
+    impl_->d.run(impl_->step_k);
+  }
+}
+void ClExplicitStepper::finish() { impl_->d.ctx.queue().finish(); }
+
+}  // namespace pneumo

@@ -1,0 +1,31 @@
+#pragma once
+// The four solvers of solver.h on an OpenCL device (kernels/msd_forces.cl, msd_integrators.cl):
+// float32, the state resident on the device across steps; only the few scalars convergence needs
+// (max |F|, max |v|, max displacement, FIRE's power and norms, Newmark's change) come back, every
+// monitor_every steps (FIRE: every step, three numbers). The 2004 scheme updates all nodes at once
+// (Jacobi) on the device, where the CPU reference goes node by node (Gauss–Seidel), as method.md §6
+// says; both stop at the same tolerance, so they reach the same equilibrium.
+#include <vector>
+
+#include "cl/cl_runtime.h"
+#include "solve/solver.h"
+
+namespace pneumo {
+
+/// Same contract as solve(): same options, same result fields, same DivergedError messages.
+SolveResult solve_opencl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt,
+                         const std::vector<Vec3>& x_start = {});
+
+/// For benchmarks: explicit steps with everything on the device and nothing read back.
+class ClExplicitStepper {
+ public:
+  ClExplicitStepper(ocl::Context& ctx, const Mesh& m, const ForceModel& model, double dt_s);
+  ~ClExplicitStepper();
+  void steps(int n);   // enqueues n steps (force evaluation + update each)
+  void finish();       // waits for the device
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
+}  // namespace pneumo
