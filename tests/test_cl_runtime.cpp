@@ -63,6 +63,31 @@ TEST(EmbeddedKernels, EveryKernelFileIsEmbedded) {
   EXPECT_THROW(ocl::kernel_source("no_such_kernel.cl"), std::runtime_error);
 }
 
+TEST(OpenCL, MissingFeaturesAreNamed) {
+  ocl::DeviceInfo d;
+  d.platform_index = 0;
+  d.device_index = 1;
+  d.name = "Old Device";
+  d.opencl_c_version = "OpenCL C 1.1 ";
+  d.max_work_group_size = 32;
+  d.local_mem_bytes = 512;
+  const std::string missing = ocl::missing_features(d, 64, 1024);
+  EXPECT_NE(missing.find("OpenCL C 1.2"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("work-groups of 64"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("1024 bytes of local memory"), std::string::npos) << missing;
+  try {
+    ocl::require_features(d, 64, 1024);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("opencl:0:1 (Old Device)"), std::string::npos) << e.what();
+  }
+  d.opencl_c_version = "OpenCL C 3.0 PoCL";
+  d.max_work_group_size = 4096;
+  d.local_mem_bytes = 1 << 20;
+  EXPECT_EQ(ocl::missing_features(d, 64, 1024), "");
+  for (const auto& real : ocl::list_devices()) EXPECT_EQ(ocl::missing_features(real, 64, 1024), "") << real.name;
+}
+
 class PerDevice : public ::testing::TestWithParam<std::string> {
  protected:
   std::shared_ptr<ocl::Context> ctx() { return ocl::Context::shared(ocl::parse_device_spec(GetParam())); }

@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <cstdio>
 #include <functional>
 #include <regex>
 #include <set>
@@ -210,6 +211,27 @@ void Context::check_fits(uint64_t bytes, uint64_t largest_buffer_bytes, const st
     throw InputError(what + " needs about " + mib(bytes) + " of device memory, more than the " +
                      mib(info_.global_mem_bytes) + " of " + info_.spec() + " (" + info_.name +
                      "): use a larger cube size or a region of interest");
+}
+
+std::string missing_features(const DeviceInfo& info, std::size_t work_group, uint64_t local_bytes) {
+  std::string missing;
+  auto add = [&](const std::string& what) { missing += (missing.empty() ? "" : "; ") + what; };
+  // "OpenCL C 1.2 ..." / "OpenCL C 3.0 ...": the major and minor numbers after "OpenCL C ".
+  int major = 0, minor = 0;
+  if (std::sscanf(info.opencl_c_version.c_str(), "OpenCL C %d.%d", &major, &minor) != 2 || major * 10 + minor < 12)
+    add("OpenCL C 1.2 (it reports '" + info.opencl_c_version + "')");
+  if (info.max_work_group_size < work_group)
+    add("work-groups of " + std::to_string(work_group) + " items (it allows " +
+        std::to_string(info.max_work_group_size) + ")");
+  if (info.local_mem_bytes < local_bytes)
+    add(std::to_string(local_bytes) + " bytes of local memory (it has " + std::to_string(info.local_mem_bytes) + ")");
+  return missing;
+}
+
+void require_features(const DeviceInfo& info, std::size_t work_group, uint64_t local_bytes) {
+  const std::string missing = missing_features(info, work_group, local_bytes);
+  if (!missing.empty())
+    throw InputError("device " + info.spec() + " (" + info.name + ") cannot run pneumo's kernels: it lacks " + missing);
 }
 
 std::string expand_includes(const std::string& source, const std::string& name) {

@@ -77,6 +77,12 @@ class Context {
   std::map<std::string, cl::Program> programs_;
 };
 
+/// What a device lacks for pneumo's kernels ("" when nothing): OpenCL C ≥ 1.2, a work-group of at
+/// least `work_group` items, `local_bytes` of local memory. Pure, so it can be tested on any info.
+std::string missing_features(const DeviceInfo& info, std::size_t work_group, uint64_t local_bytes);
+/// Throws InputError naming the device and what it lacks.
+void require_features(const DeviceInfo& info, std::size_t work_group, uint64_t local_bytes);
+
 /// Expands `#include "x.cl"` lines from the embedded kernels (each file once).
 std::string expand_includes(const std::string& source, const std::string& name);
 

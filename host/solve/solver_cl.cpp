@@ -24,7 +24,7 @@ void set_args(cl::Kernel& k, const A&... a) {
 /// constants of the integrators, and the reduction buffer.
 struct Device {
   Device(ocl::Context& ctx, const Mesh& m, const std::vector<double>& mass)
-      : ctx(ctx), m(m), n(cl_int(m.node_count())), eval(ctx, m),
+      : ctx(ctx), m(m), n(cl_int(m.node_count())), eval(checked(ctx, m), m),
         global((std::size_t(n) + kLocal - 1) / kLocal * kLocal), groups(global / kLocal), partial_host(groups) {
     std::vector<float> inv(n);
     std::vector<cl_float4> mask(n);
@@ -37,6 +37,15 @@ struct Device {
     hold = buffer(mask);
     partial = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, groups * sizeof(cl_float4));
     k_monitor = kernel("monitor");
+  }
+  /// Checks the device's features and memory before anything is allocated on it.
+  static ocl::Context& checked(ocl::Context& ctx, const Mesh& m) {
+    ocl::require_features(ctx.info(), kLocal, kLocal * sizeof(cl_float4));
+    // Beyond the force evaluator: 1/m, the hold mask, and Newmark's five state vectors at most.
+    const uint64_t solver_bytes = uint64_t(m.node_count()) * (4 + 16 + 5 * 16);
+    ctx.check_fits(ClForceEvaluator::device_bytes(m) + solver_bytes, uint64_t(m.node_count()) * 16 * 32,
+                   "this mesh (" + std::to_string(m.node_count()) + " nodes)");
+    return ctx;
   }
   template <class T>
   cl::Buffer buffer(const std::vector<T>& v) {
