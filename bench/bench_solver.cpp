@@ -29,25 +29,29 @@
 // arithmetic), double half of that; per OpenCL device its compute units × that. Set PNEUMO_BENCH_PEAK_GFLOP_S to
 // override the whole device's float32 peak (e.g. for a GPU).
 //
-// Byte counts (every array streamed once per pass; the gathers of neighbours' positions and velocities are counted
-// as cache hits, since neighbours lie within a few lattice planes of the node). A write counts once, as the triad
-// counts it.
-//   OpenCL, node_forces:  x, v (float4 each), mass (float), force write (float4), and the padded slot-major spring
-//                         table: spring_slots × (index, k, c, rest) = 16 B per slot, whole width (neighbouring nodes
-//                         alternate between 6 and 18 springs in the 5-tetrahedron lattice, so every cache line of
-//                         every slot is touched). Pressure on: per triangle its int4 and its force written and read
-//                         back (3 × 16 B), plus per node the first slot of the triangle table and one int per real
-//                         entry. Volume term on: likewise per tetrahedron (int4, rest volume, 4 float4 forces
-//                         written and read) and the tetrahedron table.
-//   OpenCL, integrator:   explicit_step reads x, v, force, the hold mask (float4 each) and 1/m (float), writes x
+// Byte counts (every array streamed once per pass; the gathers of neighbours' state are counted as cache hits, since
+// neighbours lie within a few lattice planes of the node; an element pass reads each distinct vertex's state once).
+// A write counts once, as the triad counts it. They follow kernels/msd_forces.cl and msd_integrators.cl (state as
+// displacements u = x − x₀) and host/solve/forces.cpp; change them with the kernels.
+//   OpenCL, node_forces:  u, v (float4 each), mass (float), force written (float4), and the padded slot-major spring
+//                         table: spring_slots × (index, k, c: 4 B each; rest vector and length: float4) = 28 B per
+//                         slot, whole width (on the phantom meshes a node has 10.6 springs on average of 18 slots,
+//                         but degrees 3–18 are mixed along the node order, so 99 % of the table's cache lines are
+//                         touched). Pressure on: triangle_pressure reads each triangle's int4 and its vertices' u
+//                         and x₀ (float4 each) and writes its force (float4), which node_forces reads back, plus per
+//                         node the triangle table up to its −1 (4 B an entry). Volume term on: likewise per
+//                         tetrahedron (int4, vertices' u and x₀, 4 float4 forces written and read) and its table.
+//   OpenCL, integrator:   explicit_step reads u, v, force, the hold mask (float4 each) and 1/m (float), writes u
 //                         and v: 100 B per node.
 //   CPU reference:        double Vec3 (24 B). Per spring: its 2 node ids, k, c, rest length, its force written and
 //                         read back by the gather, 2 adjacency entries; per node: x, v, mass, the adjacency row
-//                         start, the force written; per triangle: ids, force written and read, 3 adjacency
-//                         entries (+ the node's row start). Integrator: reads x, v, f, mass, hold; writes x, v.
+//                         start, the force written; per triangle: ids, its vertices' x, force written and read, 3
+//                         adjacency entries (+ each node's row start). Integrator: reads x, v, f, mass, hold;
+//                         writes x, v.
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -187,65 +191,73 @@ struct Cost {
 };
 
 /// Σ over nodes of min(degree + 1, slots): the entries a per-node loop over a padded table reads before its −1.
-double table_reads(const Csr& c, int64_t nodes, int64_t slots) {
+double table_reads(const Csr& c, int64_t nodes) {
+  int64_t slots = 1;
+  for (int64_t n = 0; n < nodes; ++n) slots = std::max(slots, c.end(n) - c.begin(n));
   double r = 0.0;
   for (int64_t n = 0; n < nodes; ++n) r += double(std::min<int64_t>(c.end(n) - c.begin(n) + 1, slots));
   return r;
 }
-int64_t max_degree(const Csr& c, int64_t nodes) {
-  int64_t d = 1;
-  for (int64_t n = 0; n < nodes; ++n) d = std::max(d, c.end(n) - c.begin(n));
-  return d;
+
+/// How many distinct nodes a list of elements touches.
+template <std::size_t K>
+double distinct_nodes(const std::vector<std::array<int32_t, K>>& elements, int64_t nodes) {
+  std::vector<char> seen(std::size_t(nodes), 0);
+  for (const auto& e : elements)
+    for (const int32_t n : e) seen[std::size_t(n)] = 1;
+  return double(std::count(seen.begin(), seen.end(), 1));
 }
 
-// FLOPs of one spring end in node_forces (nonlinear, damped): d, dv (6), length (6), dir (3), elastic part (5),
-// damper (9), sum into f (6).
-constexpr double kFlopsSpringEndCl = 35;
-// CPU reference: one evaluation per spring (the same 29 without the sum), then ± gathered at both ends (3 each).
+// FLOPs. OpenCL node_forces, one spring end (nonlinear, damped): du, dv, d = rest + du (9), length (6), direction
+// (3), elastic part (5), damper (9), sum into f (6).
+constexpr double kFlopsSpringEndCl = 38;
+// CPU reference: one evaluation per spring (d, length, direction, elastic part, damper: 29), then ± gathered at
+// both ends (3 each).
 constexpr double kFlopsSpringCpu = 29 + 6;
-constexpr double kFlopsTriangle = 24 + 9;       // area normal, scaled; gathered at its 3 vertices
-constexpr double kFlopsTet = 74 + 12;           // 3 cross products, volume, scale; gathered at 4 vertices
+constexpr double kFlopsTriangleCl = 36 + 9;     // two edges from rest + displacement, area normal, scaled; 3 gathers
+constexpr double kFlopsTriangleCpu = 24 + 9;    // two edges, area normal, scaled; 3 gathers
+constexpr double kFlopsTet = 90 + 12;           // 3 edges, 3 cross products, volumes, scale; 4 gathers
 constexpr double kFlopsGravity = 3;
-constexpr double kFlopsIntegrator = 13;         // dt/m, v += (dt/m) f, x += dt v
+constexpr double kFlopsIntegratorCpu = 13;      // dt/m, v += (dt/m) f, x += dt v
+constexpr double kFlopsIntegratorCl = 16;       // the same and the hold mask's multiply
+
+constexpr double kClSpringSlotBytes = 4 + 4 + 4 + 16;             // index, k, c, (rest vector, rest length)
+constexpr double kClIntegratorBytes = 3 * 16 + 16 + 4 + 2 * 16;   // u, v, f, hold mask, 1/m; u, v written
+constexpr double kCpuIntegratorBytes = 3 * 24 + 8 + 1 + 2 * 24;   // x, v, f, mass, hold; x, v written
 
 Cost cl_force_cost(const Mesh& m, const ForceModel& model, int spring_slots) {
-  const Adjacency a = Adjacency::of(m);
-  const double N = double(m.node_count()), S = double(m.springs.size()), R = double(m.cavity_tris.size()),
-               T = double(m.tets.size());
-  Cost c;
-  double bytes = N * (16 + 16 + 4 + 16) + N * double(spring_slots) * 16;
-  double flops = 2 * S * kFlopsSpringEndCl + N * kFlopsGravity;
+  const int64_t N = m.node_count();
+  const double S = double(m.springs.size()), R = double(m.cavity_tris.size()), T = double(m.tets.size());
+  double bytes = double(N) * (16 + 16 + 4 + 16 + spring_slots * kClSpringSlotBytes);
+  double flops = 2 * S * kFlopsSpringEndCl + double(N) * kFlopsGravity;
   if (model.pressure_pa != 0.0 && R > 0) {
-    bytes += R * 3 * 16 + 4 * table_reads(a.tris, m.node_count(), max_degree(a.tris, m.node_count()));
-    flops += R * kFlopsTriangle;
+    const Adjacency a = Adjacency::of(m);
+    bytes += R * (16 + 16 + 16) + 32 * distinct_nodes(m.cavity_tris, N) + 4 * table_reads(a.tris, N);
+    flops += R * kFlopsTriangleCl;
   }
   if (model.volume_stiffness_pa != 0.0 && T > 0) {
-    bytes += T * (16 + 4 + 2 * 64) + 4 * table_reads(a.tets, m.node_count(), max_degree(a.tets, m.node_count()));
+    const Adjacency a = Adjacency::of(m);
+    bytes += T * (16 + 64 + 64) + 32 * distinct_nodes(m.tets, N) + 4 * table_reads(a.tets, N);
     flops += T * kFlopsTet;
   }
-  c.bytes = bytes / N;
-  c.flops = flops / N;
-  return c;
+  return Cost{bytes / double(N), flops / double(N)};
 }
-constexpr double kClIntegratorBytes = 3 * 16 + 4 + 16 + 2 * 16;   // x, v, f, 1/m, hold mask; x, v
-constexpr double kFlopsIntegratorCl = kFlopsIntegrator + 3;            // the hold mask's multiply
 
 Cost cpu_force_cost(const Mesh& m, const ForceModel& model) {
-  const double N = double(m.node_count()), S = double(m.springs.size()), R = double(m.cavity_tris.size()),
-               T = double(m.tets.size());
-  double bytes = N * (24 + 24 + 8 + 8 + 24) + S * (8 + 3 * 8 + 24 + 24 + 2 * 4);
-  double flops = S * kFlopsSpringCpu + N * kFlopsGravity;
+  const int64_t N = m.node_count();
+  const double S = double(m.springs.size()), R = double(m.cavity_tris.size()), T = double(m.tets.size());
+  double bytes = double(N) * (24 + 24 + 8 + 8 + 24) + S * (8 + 3 * 8 + 24 + 24 + 2 * 4);
+  double flops = S * kFlopsSpringCpu + double(N) * kFlopsGravity;
   if (model.pressure_pa != 0.0 && R > 0) {
-    bytes += R * (12 + 24 + 24 + 3 * 4) + N * 8;
-    flops += R * kFlopsTriangle;
+    bytes += R * (12 + 24 + 24 + 3 * 4) + 24 * distinct_nodes(m.cavity_tris, N) + double(N) * 8;
+    flops += R * kFlopsTriangleCpu;
   }
   if (model.volume_stiffness_pa != 0.0 && T > 0) {
-    bytes += T * (16 + 8 + 2 * 96 + 4 * 4) + N * 8;
+    bytes += T * (16 + 8 + 2 * 96 + 4 * 4) + 24 * distinct_nodes(m.tets, N) + double(N) * 8;
     flops += T * kFlopsTet;
   }
-  return Cost{bytes / N, flops / N};
+  return Cost{bytes / double(N), flops / double(N)};
 }
-constexpr double kCpuIntegratorBytes = 3 * 24 + 8 + 1 + 2 * 24;
 
 /// Sets the roofline counters from the achieved node rate (node-updates or node force evaluations per second).
 void report_roofline(benchmark::State& state, const Mesh& m, const Cost& cost, double node_rate,
@@ -393,7 +405,7 @@ void BM_ExplicitStepCpu(benchmark::State& state, PhantomSize size, int threads) 
   mesh_counters(state, m);
   Cost cost = cpu_force_cost(m, mc.model);
   cost.bytes += kCpuIntegratorBytes;
-  cost.flops += kFlopsIntegrator;
+  cost.flops += kFlopsIntegratorCpu;
   report_roofline(state, m, cost, steps * double(N) / seconds, bw, 0.5 * kPeakF32PerCore * threads,
                   "CPU reference, double, " + std::to_string(threads) + " thread(s)");
 }
