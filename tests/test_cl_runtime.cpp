@@ -8,6 +8,7 @@
 #include <random>
 
 #include "cl/cl_runtime.h"
+#include "opencl_test_support.h"
 #include "cl/embedded_kernels.h"
 #include "core/error.h"
 #include "perf/bandwidth.h"
@@ -93,12 +94,6 @@ class PerDevice : public ::testing::TestWithParam<std::string> {
   std::shared_ptr<ocl::Context> ctx() { return ocl::Context::shared(ocl::parse_device_spec(GetParam())); }
 };
 
-std::vector<std::string> opencl_device_specs() {
-  std::vector<std::string> specs;
-  for (const auto& d : ocl::list_devices()) specs.push_back(d.spec());
-  return specs;
-}
-
 // Triad against its reference on random input. Tolerance: 1 ulp of the result's magnitude, because
 // OpenCL C may contract b + s*c into one fma (FP_CONTRACT is on by default) while the host may not.
 TEST_P(PerDevice, TriadKernelMatchesReference) {
@@ -174,9 +169,5 @@ TEST_P(PerDevice, ACaseTooLargeIsRefusedBeforeAllocatingWithTheEstimate) {
 }
 
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(PerDevice);
-INSTANTIATE_TEST_SUITE_P(OpenCL, PerDevice, ::testing::ValuesIn(opencl_device_specs()),
-                         [](const auto& info) {
-                           std::string s = info.param;
-                           for (char& ch : s) if (ch == ':') ch = '_';
-                           return s;
-                         });
+INSTANTIATE_TEST_SUITE_P(OpenCL, PerDevice, ::testing::ValuesIn(testing_support::opencl_device_specs()),
+                         [](const auto& info) { return testing_support::spec_name(info.param); });

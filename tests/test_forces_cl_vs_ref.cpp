@@ -15,6 +15,7 @@
 #include <random>
 
 #include "cl/cl_runtime.h"
+#include "opencl_test_support.h"
 #include "mesh/adjacency.h"
 #include "solve/forces.h"
 #include "solve/forces_cl.h"
@@ -22,12 +23,6 @@
 using namespace pneumo;
 
 namespace {
-
-std::vector<std::string> opencl_devices() {
-  std::vector<std::string> specs;
-  for (const auto& d : ocl::list_devices()) specs.push_back(d.spec());
-  return specs;
-}
 
 struct RandomCase {
   Mesh mesh;
@@ -137,8 +132,4 @@ TEST_P(ForcesClVsRef, StateStaysOnTheDeviceBetweenEvaluations) {
 }  // namespace
 
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(ForcesClVsRef);
-INSTANTIATE_TEST_SUITE_P(OpenCL, ForcesClVsRef, ::testing::ValuesIn(opencl_devices()), [](const auto& info) {
-  std::string s = info.param;
-  for (char& ch : s) if (ch == ':') ch = '_';
-  return s;
-});
+INSTANTIATE_TEST_SUITE_P(OpenCL, ForcesClVsRef, ::testing::ValuesIn(testing_support::opencl_device_specs()), [](const auto& info) { return testing_support::spec_name(info.param); });

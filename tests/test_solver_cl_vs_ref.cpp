@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "cl/cl_runtime.h"
+#include "opencl_test_support.h"
 #include "core/progress.h"
 #include "solve/solver.h"
 #include "solve/solver_cl.h"
@@ -11,12 +12,6 @@
 using namespace pneumo;
 
 namespace {
-
-std::vector<std::string> opencl_devices() {
-  std::vector<std::string> specs;
-  for (const auto& d : ocl::list_devices()) specs.push_back(d.spec());
-  return specs;
-}
 
 /// 12×12×4 voxels of 5 mm: viscera at the bottom, two wall layers above, a fixed rim; soft
 /// (E = 60 kPa).
@@ -109,9 +104,7 @@ TEST_P(SolverClVsRef, ReachesTheSameEquilibrium) {
 }
 
 std::string name(const ::testing::TestParamInfo<std::tuple<std::string, SolverMethod>>& info) {
-  std::string s = std::get<0>(info.param) + "_" + enum_name(std::get<1>(info.param));
-  for (char& ch : s) if (ch == ':') ch = '_';
-  return s;
+  return testing_support::spec_name(std::get<0>(info.param)) + "_" + enum_name(std::get<1>(info.param));
 }
 
 class NewmarkClBeyondStable : public ::testing::TestWithParam<std::string> {};
@@ -138,13 +131,9 @@ TEST_P(NewmarkClBeyondStable, FailsCleanly) {
 
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(SolverClVsRef);
 INSTANTIATE_TEST_SUITE_P(OpenCL, SolverClVsRef,
-                         ::testing::Combine(::testing::ValuesIn(opencl_devices()),
+                         ::testing::Combine(::testing::ValuesIn(testing_support::opencl_device_specs()),
                                             ::testing::Values(SolverMethod::Explicit, SolverMethod::Newmark,
                                                               SolverMethod::Kitasaka2004, SolverMethod::Static)),
                          name);
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(NewmarkClBeyondStable);
-INSTANTIATE_TEST_SUITE_P(OpenCL, NewmarkClBeyondStable, ::testing::ValuesIn(opencl_devices()), [](const auto& info) {
-  std::string s = info.param;
-  for (char& ch : s) if (ch == ':') ch = '_';
-  return s;
-});
+INSTANTIATE_TEST_SUITE_P(OpenCL, NewmarkClBeyondStable, ::testing::ValuesIn(testing_support::opencl_device_specs()), [](const auto& info) { return testing_support::spec_name(info.param); });

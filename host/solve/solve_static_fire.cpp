@@ -38,8 +38,7 @@ SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vecto
     model.pressure_pa = opt.forces.pressure_pa * double(inc) / increments;
     const bool last = inc == increments;
     const double tol = opt.residual_tolerance * (last ? 1.0 : F::kIntermediateToleranceFactor);
-    double dt = F::kDtStart, alpha = F::kAlphaStart;
-    int positive = 0;
+    detail::FireControl fire;
     std::fill(v.begin(), v.end(), Vec3::Zero());
     eval.evaluate(model, x, {}, f);
     detail::apply_holds(m, f);
@@ -47,18 +46,11 @@ SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vecto
     while (step < opt.max_steps) {
       double power = 0.0;
       for (int64_t n = 0; n < N; ++n) power += f[n].dot(v[n]);
-      if (power > 0.0) {
-        if (++positive > F::kDelaySteps) {
-          dt = std::min(dt * F::kGrow, F::kDtMax);
-          alpha *= F::kAlphaShrink;
-        }
-      } else {
-        positive = 0;
-        dt = std::max(dt * F::kShrink, F::kDtMin);
-        alpha = F::kAlphaStart;
-        for (int64_t n = 0; n < N; ++n) x[n] -= 0.5 * dt * v[n];
+      if (fire.after_power(power)) {
+        for (int64_t n = 0; n < N; ++n) x[n] -= 0.5 * fire.dt * v[n];
         std::fill(v.begin(), v.end(), Vec3::Zero());
       }
+      const double dt = fire.dt, alpha = fire.alpha;
       for (int64_t n = 0; n < N; ++n) v[n] += dt / mass[n] * f[n];
       if (power > 0.0) {
         double vnorm = 0.0, fnorm = 0.0;

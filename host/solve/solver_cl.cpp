@@ -271,25 +271,17 @@ SolveResult static_fire_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions&
     model.pressure_pa = opt.forces.pressure_pa * double(inc) / increments;
     const bool last = inc == increments;
     const double tol = opt.residual_tolerance * (last ? 1.0 : F::kIntermediateToleranceFactor);
-    double dt = F::kDtStart, alpha = F::kAlphaStart;
-    int positive = 0;
+    detail::FireControl fire;
     ctx.queue().enqueueFillBuffer(v, cl_float4{{0, 0, 0, 0}}, 0, std::size_t(d.n) * sizeof(cl_float4));
     evaluate();
     bool increment_done = false;
     while (step < opt.max_steps) {
       const double power = d.reduce(sums, true)[0];
-      if (power > 0.0) {
-        if (++positive > F::kDelaySteps) {
-          dt = std::min(dt * F::kGrow, F::kDtMax);
-          alpha *= F::kAlphaShrink;
-        }
-      } else {
-        positive = 0;
-        dt = std::max(dt * F::kShrink, F::kDtMin);
-        alpha = F::kAlphaStart;
-        set_args(restart, x, v, float(dt), d.n);
+      if (fire.after_power(power)) {
+        set_args(restart, x, v, float(fire.dt), d.n);
         d.run(restart);
       }
+      const double dt = fire.dt, alpha = fire.alpha;
       set_args(velocity, v, f, d.inv_mass, float(dt), d.n);
       d.run(velocity);
       double v_over_f = 0.0;

@@ -1,6 +1,7 @@
 #pragma once
 // What every solver shares: holds, the residual and its reference load, divergence checks,
 // the history and progress. Internal to host/solve.
+#include <algorithm>
 #include <chrono>
 #include <functional>
 #include <string>
@@ -23,6 +24,28 @@ struct Fire {
   static constexpr double kGrow = 1.1, kShrink = 0.5, kAlphaStart = 0.1, kAlphaShrink = 0.99;
   static constexpr double kIntermediateToleranceFactor = 10.0;   // rough equilibrium between increments
 };
+/// FIRE's step control: after each power P = F·v, grow the step and relax the mixing while P > 0
+/// (after a delay), or shrink the step and restart (the caller then moves x back by ½Δt·v and
+/// zeroes v) when P ≤ 0. Shared by the CPU and device solvers so both take the same steps.
+struct FireControl {
+  double dt = Fire::kDtStart, alpha = Fire::kAlphaStart;
+  int positive = 0;
+  /// Returns true when the caller must restart (P ≤ 0).
+  bool after_power(double power) {
+    if (power > 0.0) {
+      if (++positive > Fire::kDelaySteps) {
+        dt = std::min(dt * Fire::kGrow, Fire::kDtMax);
+        alpha *= Fire::kAlphaShrink;
+      }
+      return false;
+    }
+    positive = 0;
+    dt = std::max(dt * Fire::kShrink, Fire::kDtMin);
+    alpha = Fire::kAlphaStart;
+    return true;
+  }
+};
+
 /// FIRE's fictitious masses: each node's spring stiffness sum (plus the volume term's, when on).
 std::vector<double> fire_masses(const Mesh& m, const SolveOptions& opt);
 /// Number of load increments for the static solver.
