@@ -122,11 +122,12 @@ void Monitor::check_diverged(double max_displacement_m, int64_t step, const std:
   if (max_displacement_m <= extent_m_) return;
   std::ostringstream os;
   os.precision(3);
-  os << r_.solver << " diverged at step " << step << " ("
-     << (std::isfinite(max_displacement_m)
-             ? "a node moved " + std::to_string(units::m_to_mm(max_displacement_m)) + " mm, beyond the model's size"
-             : std::string("non-finite positions"))
-     << "): " << advice;
+  os << r_.solver << " diverged at step " << step << " (";
+  if (std::isfinite(max_displacement_m))
+    os << "a node moved " << units::m_to_mm(max_displacement_m) << " mm, beyond the model's size";
+  else
+    os << "non-finite positions";
+  os << "): " << advice;
   throw DivergedError(os.str(), r_.dt_stable_s);
 }
 
