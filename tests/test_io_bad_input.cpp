@@ -4,7 +4,6 @@
 #include <nifti1.h>
 #include <zlib.h>
 
-#include <chrono>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -377,7 +376,8 @@ TEST_P(IoBadInput, IsRefusedWithAnInputErrorNamingTheFile) {
   const BadInput& row = GetParam();
   ScratchDir dir;
   const std::string path = row.make(dir);
-  const auto start = std::chrono::steady_clock::now();
+  // No timing here (tests never assert on time): the absurd-header rows prove the refusal comes
+  // before allocation by their message, which only the pre-allocation check writes.
   try {
     const Volume v = read_volume(path);
     ADD_FAILURE() << "read " << v.voxel_count() << " voxels from a bad file";
@@ -390,9 +390,6 @@ TEST_P(IoBadInput, IsRefusedWithAnInputErrorNamingTheFile) {
   } catch (const std::exception& e) {
     ADD_FAILURE() << "not an InputError: " << e.what();
   }
-  // Failing fast means nothing the header promises was allocated or read.
-  const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_LT(elapsed_s, 0.5);
 }
 
 INSTANTIATE_TEST_SUITE_P(Table, IoBadInput, ::testing::ValuesIn(bad_inputs()),

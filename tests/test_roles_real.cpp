@@ -36,7 +36,7 @@ const RoleVolume& real_roles(double* seconds = nullptr) {
 
 }  // namespace
 
-TEST(RolesRealCT, PaddedGridAndTimings) {
+TEST(RolesRealCT, PaddedGridKeepsEveryVoxel) {
   PNEUMO_REQUIRE_SHARED_DATA();
   double seconds = 0;
   const RoleVolume& rv = real_roles(&seconds);
@@ -51,9 +51,8 @@ TEST(RolesRealCT, PaddedGridAndTimings) {
     EXPECT_EQ(rv.ct.data<float>()[rv.geometry.linear_index(v[0] + 20, v[1], v[2])], float(ct.value(v[0], v[1], v[2])));
   EXPECT_EQ(rv.ct.data<float>()[rv.geometry.linear_index(5, 60, 50)], -1000.0f);
   EXPECT_EQ(rv.ct.data<float>()[rv.geometry.linear_index(80, 115, 50)], -1000.0f);
-  // Reading the two files and assigning roles: well under the brief's "a few seconds".
+  // Reported, not asserted (tests never assert on time; bench/ measures speed).
   RecordProperty("load_roles_seconds", std::to_string(seconds));
-  EXPECT_LT(seconds, 5.0);
 }
 
 TEST(RolesRealCT, RoleVolumesAreThoseOfAnAdultAbdomen) {

@@ -83,6 +83,13 @@ std::string missing_features(const DeviceInfo& info, std::size_t work_group, uin
 /// Throws InputError naming the device and what it lacks.
 void require_features(const DeviceInfo& info, std::size_t work_group, uint64_t local_bytes);
 
+/// Sets a kernel's arguments in order: set_args(k, a, b, c) is k.setArg(0, a); k.setArg(1, b); ...
+template <class... A>
+void set_args(cl::Kernel& k, const A&... a) {
+  cl_uint i = 0;
+  (k.setArg(i++, a), ...);
+}
+
 /// Expands `#include "x.cl"` lines from the embedded kernels (each file once).
 std::string expand_includes(const std::string& source, const std::string& name);
 

@@ -43,23 +43,23 @@ std::vector<cl_float4> to_float4(const std::vector<Vec3>& v) {
   return out;
 }
 
-uint64_t ClForceEvaluator::device_bytes(const Mesh& m) {
-  const Adjacency a = Adjacency::of(m);
-  const uint64_t N = m.node_count();
-  const uint64_t ss = max_degree(a.springs, N), ts = max_degree(a.tris, N), vs = max_degree(a.tets, N);
-  return N * (4 * 16 + 4)                       // u, v, rest, force; mass
-         + ss * N * 28                          // neighbour, k, c, rest vector and length
-         + m.cavity_tris.size() * 32 + ts * N * 4 + m.tets.size() * (16 + 64) + vs * N * 4;
-}
-
-ClForceEvaluator::ClForceEvaluator(ocl::Context& ctx, const Mesh& m)
+ClForceEvaluator::ClForceEvaluator(ocl::Context& ctx, const Mesh& m, uint64_t extra_bytes_per_node)
     : ctx_(ctx), nodes_(m.node_count()), tris_(int64_t(m.cavity_tris.size())), tets_(int64_t(m.tets.size())) {
-  const uint64_t largest = std::max<uint64_t>(uint64_t(tets_) * 64, uint64_t(nodes_) * 16 * 18);
-  ctx.check_fits(device_bytes(m), largest, "this mesh (" + std::to_string(nodes_) + " nodes)");
   const Adjacency adj = Adjacency::of(m);
   spring_slots_ = max_degree(adj.springs, nodes_);
   tri_slots_ = max_degree(adj.tris, nodes_);
   tet_slots_ = max_degree(adj.tets, nodes_);
+  {
+    // Everything below, before any of it is allocated: node state (u, v, x₀, F: float4; mass), the
+    // spring table (index, k, c: 4 bytes each; rest vector: 16 per slot), triangles and their
+    // forces, tetrahedra and their 4 vertex forces, the two padded element tables.
+    const uint64_t N = uint64_t(nodes_), T = uint64_t(tets_), R = uint64_t(tris_);
+    const uint64_t spring_table = uint64_t(spring_slots_) * N;
+    const uint64_t total = N * (4 * 16 + 4 + extra_bytes_per_node) + spring_table * 28 + R * 32 +
+                           uint64_t(tri_slots_) * N * 4 + T * (16 + 64) + uint64_t(tet_slots_) * N * 4;
+    const uint64_t largest = std::max({spring_table * 16, T * 64, N * 16});
+    ctx.check_fits(total, largest, "this mesh (" + std::to_string(nodes_) + " nodes)");
+  }
 
   // Springs seen from each node: the other end, and the spring's constants.
   const std::vector<int> spring_of = padded_table(adj.springs, nodes_, spring_slots_, [](int32_t it) { return it; });
@@ -121,44 +121,19 @@ void ClForceEvaluator::evaluate(const ForceModel& model) {
   auto& q = ctx_.queue();
   const bool pressure = model.pressure_pa != 0.0 && tris_ > 0, volume = model.volume_stiffness_pa != 0.0;
   if (pressure) {
-    k_tri_.setArg(0, x_);
-    k_tri_.setArg(1, rest_x_);
-    k_tri_.setArg(2, tris_buf_);
-    k_tri_.setArg(3, float(model.pressure_pa));
-    k_tri_.setArg(4, cl_int(tris_));
-    k_tri_.setArg(5, tri_force_);
+    ocl::set_args(k_tri_, x_, rest_x_, tris_buf_, float(model.pressure_pa), cl_int(tris_), tri_force_);
     q.enqueueNDRangeKernel(k_tri_, cl::NullRange, cl::NDRange(global_size(tris_)), cl::NDRange(kLocal));
   }
   if (volume) {
-    k_tet_.setArg(0, x_);
-    k_tet_.setArg(1, rest_x_);
-    k_tet_.setArg(2, tets_buf_);
-    k_tet_.setArg(3, float(model.volume_stiffness_pa));
-    k_tet_.setArg(4, cl_int(tets_));
-    k_tet_.setArg(5, tet_force_);
+    ocl::set_args(k_tet_, x_, rest_x_, tets_buf_, float(model.volume_stiffness_pa), cl_int(tets_), tet_force_);
     q.enqueueNDRangeKernel(k_tet_, cl::NullRange, cl::NDRange(global_size(tets_)), cl::NDRange(kLocal));
   }
-  int a = 0;
-  k_node_.setArg(a++, x_);
-  k_node_.setArg(a++, v_);
-  k_node_.setArg(a++, mass_);
-  k_node_.setArg(a++, cl_int(nodes_));
-  k_node_.setArg(a++, spring_node_);
-  k_node_.setArg(a++, spring_k_);
-  k_node_.setArg(a++, spring_c_);
-  k_node_.setArg(a++, spring_rest_);
-  k_node_.setArg(a++, cl_int(spring_slots_));
-  k_node_.setArg(a++, cl_int(model.spring_model == SpringModel::Linear));
-  k_node_.setArg(a++, cl_int(model.damping));
-  k_node_.setArg(a++, tri_force_);
-  k_node_.setArg(a++, node_tri_);
-  k_node_.setArg(a++, cl_int(pressure ? tri_slots_ : 0));
-  k_node_.setArg(a++, tet_force_);
-  k_node_.setArg(a++, node_tet_);
-  k_node_.setArg(a++, cl_int(volume ? tet_slots_ : 0));
-  k_node_.setArg(a++, cl_float4{{float(model.gravity_m_s2[0]), float(model.gravity_m_s2[1]),
-                                 float(model.gravity_m_s2[2]), 0.0f}});
-  k_node_.setArg(a++, f_);
+  ocl::set_args(k_node_, x_, v_, mass_, cl_int(nodes_), spring_node_, spring_k_, spring_c_, spring_rest_,
+                cl_int(spring_slots_), cl_int(model.spring_model == SpringModel::Linear), cl_int(model.damping),
+                tri_force_, node_tri_, cl_int(pressure ? tri_slots_ : 0), tet_force_, node_tet_,
+                cl_int(volume ? tet_slots_ : 0),
+                cl_float4{{float(model.gravity_m_s2[0]), float(model.gravity_m_s2[1]), float(model.gravity_m_s2[2]), 0.0f}},
+                f_);
   q.enqueueNDRangeKernel(k_node_, cl::NullRange, cl::NDRange(global_size(nodes_)), cl::NDRange(kLocal));
 }
 

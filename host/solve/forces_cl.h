@@ -13,12 +13,9 @@ namespace pneumo {
 
 class ClForceEvaluator {
  public:
-  /// Uploads the mesh. Checks the memory it needs against the device first (InputError if it
-  /// does not fit, with the estimate).
-  ClForceEvaluator(ocl::Context& ctx, const Mesh& mesh);
-
-  /// Device bytes this mesh needs (tables, state, forces).
-  static uint64_t device_bytes(const Mesh& mesh);
+  /// Uploads the mesh. Checks the memory it needs, plus `extra_bytes_per_node` the caller will
+  /// allocate beside it, against the device first (InputError with the estimate if it does not fit).
+  ClForceEvaluator(ocl::Context& ctx, const Mesh& mesh, uint64_t extra_bytes_per_node = 0);
 
   /// Positions x (metres) go up as displacements x − x₀, formed in double.
   void upload_state(const std::vector<Vec3>& x, const std::vector<Vec3>& v);

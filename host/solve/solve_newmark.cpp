@@ -42,9 +42,8 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
       xp[n] = x[n] + dt * v[n] + (0.5 - beta) * dt * dt * a[n];
       vp[n] = v[n] + (1.0 - gamma) * dt * a[n];
     }
-    double change = INFINITY, previous_change = INFINITY;
-    int growing = 0, k = 0;
-    for (; k < opt.newmark_max_inner; ++k) {
+    detail::NewmarkInnerLoop inner(opt.newmark_inner_tolerance, 0.0);
+    for (int k = 0; k < opt.newmark_max_inner; ++k) {
       for (int64_t n = 0; n < N; ++n) {
         xt[n] = xp[n] + beta * dt * dt * a[n];
         vt[n] = vp[n] + gamma * dt * a[n];
@@ -52,22 +51,16 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
       eval.evaluate(model, xt, vt, f);
       for (int64_t n = 0; n < N; ++n) a_next[n] = f[n] / m.mass_kg[n];
       detail::apply_holds(m, a_next);
-      change = 0.0;
+      double change = 0.0;
       for (int64_t n = 0; n < N; ++n) change = std::max(change, (a_next[n] - a[n]).norm());
       a.swap(a_next);
       ++r.inner_iterations;
-      const double scale = std::max(max_norm(a), a_floor);
-      if (!std::isfinite(change)) break;
-      if (change <= opt.newmark_inner_tolerance * scale) break;
-      growing = change > previous_change ? growing + 1 : 0;
-      if (growing >= 3) break;   // a fixed-point iteration whose change keeps growing diverges
-      previous_change = change;
+      if (inner.next(change, std::max(max_norm(a), a_floor))) break;
     }
-    const double scale = std::max(max_norm(a), a_floor);
-    if (!std::isfinite(change) || change > opt.newmark_inner_tolerance * scale) {
-      throw DivergedError(detail::newmark_failure(step + 1, change / scale, k + 1, opt, dt, r.dt_stable_s),
-                          r.dt_stable_s);
-    }
+    if (inner.failed())
+      throw DivergedError(
+          detail::newmark_failure(step + 1, inner.relative_change(), inner.iterations(), opt, dt, r.dt_stable_s),
+          r.dt_stable_s);
     for (int64_t n = 0; n < N; ++n) {
       x[n] = xp[n] + beta * dt * dt * a[n];
       v[n] = vp[n] + gamma * dt * a[n];

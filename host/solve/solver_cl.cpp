@@ -14,17 +14,13 @@ namespace {
 
 constexpr std::size_t kLocal = 64;   // LOCAL_SIZE of kernels/msd_integrators.cl
 
-template <class... A>
-void set_args(cl::Kernel& k, const A&... a) {
-  cl_uint i = 0;
-  (k.setArg(i++, a), ...);
-}
+using ocl::set_args;
 
 /// What a device solver holds: the force evaluator (positions, velocities, forces), the per-node
 /// constants of the integrators, and the reduction buffer.
 struct Device {
   Device(ocl::Context& ctx, const Mesh& m, const std::vector<double>& mass)
-      : ctx(ctx), m(m), n(cl_int(m.node_count())), eval(checked(ctx, m), m),
+      : ctx(ctx), m(m), n(cl_int(m.node_count())), eval(with_features(ctx), m, kSolverBytesPerNode),
         global((std::size_t(n) + kLocal - 1) / kLocal * kLocal), groups(global / kLocal), partial_host(groups) {
     std::vector<float> inv(n);
     std::vector<cl_float4> mask(n);
@@ -38,13 +34,12 @@ struct Device {
     partial = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, groups * sizeof(cl_float4));
     k_monitor = kernel("monitor");
   }
-  /// Checks the device's features and memory before anything is allocated on it.
-  static ocl::Context& checked(ocl::Context& ctx, const Mesh& m) {
+  // Beyond the force evaluator, per node: 1/m, the hold mask, and Newmark's five state vectors at
+  // most. The evaluator checks the total against the device before allocating anything.
+  static constexpr uint64_t kSolverBytesPerNode = 4 + 16 + 5 * 16;
+  /// Checks the device's features (the reductions need work-groups and local memory).
+  static ocl::Context& with_features(ocl::Context& ctx) {
     ocl::require_features(ctx.info(), kLocal, kLocal * sizeof(cl_float4));
-    // Beyond the force evaluator: 1/m, the hold mask, and Newmark's five state vectors at most.
-    const uint64_t solver_bytes = uint64_t(m.node_count()) * (4 + 16 + 5 * 16);
-    ctx.check_fits(ClForceEvaluator::device_bytes(m) + solver_bytes, uint64_t(m.node_count()) * 16 * 32,
-                   "this mesh (" + std::to_string(m.node_count()) + " nodes)");
     return ctx;
   }
   template <class T>
@@ -145,11 +140,10 @@ SolveResult newmark_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt
   const float beta = float(opt.newmark_beta), gamma = float(opt.newmark_gamma);
   const double a_floor = detail::newmark_acceleration_floor(m, mon);
   // float32 cannot resolve a relative change below its noise floor, which depends on how much the
-  // forces cancel (typically 1e-6..1e-4 of max |a|). The loop therefore also ends when the change has
-  // stopped falling (3 iterations), or the iterations run out, while below kNoiseFloorBound: the floor
-  // is reached, not a divergence (a diverging fixed-point iteration grows far past it).
-  const double inner_tolerance = opt.newmark_inner_tolerance;
-  constexpr double kNoiseFloorBound = 1e-3;
+  // forces cancel (typically 1e-6..1e-4 of max |a|): a change that stops falling, or outlasts the
+  // iterations, below 1e-3 of max |a| is that floor, not a divergence (a diverging fixed-point
+  // iteration grows far past it).
+  constexpr double kNoiseFloor = 1e-3;
   Device d(ctx, m, m.mass_kg);
   d.eval.upload_state(x0, {});
   cl::Buffer x = d.zeros4(), v = d.zeros4();
@@ -170,27 +164,19 @@ SolveResult newmark_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt
     const double t_next = (step + 1) * dt;
     model.pressure_pa = opt.forces.pressure_pa * ramp_factor(t_next, opt.ramp_s, opt.ramp_shape);
     d.run(predict);
-    double change = INFINITY, previous_change = INFINITY, scale = a_floor;
-    int growing = 0, k = 0;
-    bool at_floor = false;
-    for (; k < opt.newmark_max_inner; ++k) {
+    detail::NewmarkInnerLoop inner(opt.newmark_inner_tolerance, kNoiseFloor);
+    for (int k = 0; k < opt.newmark_max_inner; ++k) {
       d.run(trial);
       d.eval.evaluate(model);
       ++evaluations;
       const auto red = d.reduce(accel, false);
-      change = red[0];
-      scale = std::max(red[1], a_floor);
       ++r.inner_iterations;
-      if (!std::isfinite(change)) break;
-      if (change <= inner_tolerance * scale) break;
-      growing = change >= previous_change ? growing + 1 : 0;
-      if (growing >= 3) break;
-      previous_change = change;
+      if (inner.next(red[0], std::max(red[1], a_floor))) break;
     }
-    at_floor = std::isfinite(change) && change <= kNoiseFloorBound * scale;
-    if (!std::isfinite(change) || (change > inner_tolerance * scale && !at_floor))
-      throw DivergedError(detail::newmark_failure(step + 1, change / scale, k + 1, opt, dt, r.dt_stable_s),
-                          r.dt_stable_s);
+    if (inner.failed())
+      throw DivergedError(
+          detail::newmark_failure(step + 1, inner.relative_change(), inner.iterations(), opt, dt, r.dt_stable_s),
+          r.dt_stable_s);
     d.run(commit);
     ++step;
     if (step % opt.monitor_every != 0 && step != opt.max_steps) continue;

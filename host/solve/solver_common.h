@@ -3,6 +3,7 @@
 // the history and progress. Internal to host/solve.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -44,6 +45,37 @@ struct FireControl {
     alpha = Fire::kAlphaStart;
     return true;
   }
+};
+
+/// Newmark-β's inner loop control, shared by the CPU and device solvers: call next() after each
+/// iteration with the largest change of the accelerations and the scale it is measured against
+/// (max |a|, floored); it says when to stop. The loop stops when the change is below the tolerance,
+/// is not finite, or has not fallen for 3 iterations (a fixed-point iteration that keeps growing
+/// diverges). With `noise_floor` > 0 (float32 devices), a change that stops falling below
+/// noise_floor·scale is the arithmetic's floor, not a divergence.
+class NewmarkInnerLoop {
+ public:
+  NewmarkInnerLoop(double tolerance, double noise_floor) : tolerance_(tolerance), noise_floor_(noise_floor) {}
+  bool next(double change, double scale) {
+    change_ = change;
+    scale_ = scale;
+    ++iterations_;
+    if (!std::isfinite(change) || change <= tolerance_ * scale) return true;
+    growing_ = change >= previous_ ? growing_ + 1 : 0;
+    previous_ = change;
+    return growing_ >= 3;
+  }
+  bool failed() const {
+    if (!std::isfinite(change_)) return true;
+    return change_ > tolerance_ * scale_ && !(change_ <= noise_floor_ * scale_);
+  }
+  double relative_change() const { return change_ / scale_; }
+  int iterations() const { return iterations_; }
+
+ private:
+  double tolerance_, noise_floor_;
+  double change_ = INFINITY, previous_ = INFINITY, scale_ = 1.0;
+  int growing_ = 0, iterations_ = 0;
 };
 
 /// FIRE's fictitious masses: each node's spring stiffness sum (plus the volume term's, when on).
