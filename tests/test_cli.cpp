@@ -92,3 +92,24 @@ TEST(Cli, DevicesListsTheReferenceAndOpenCL) {
   for (std::size_t i = 1; i < j.size(); ++i)
     for (const char* key : {"type", "compute_units", "global_mem_bytes", "fp64"}) EXPECT_TRUE(j[i].contains(key)) << key;
 }
+
+TEST(Cli, ValidateJsonHasTheDocumentedKeys) {
+  // Compared: the keys issue 3 names for `validate lattice --json` and `validate lame-sphere --json`
+  // (users script against them), and the lattice's ratio against §4's 1.140 (±2 %).
+  auto lat = run_pneumo("validate lattice --json");
+  ASSERT_EQ(lat.code, 0) << lat.err;
+  const auto jl = nlohmann::json::parse(lat.out);
+  EXPECT_NEAR(jl.at("young_ratio_axis").get<double>(), 1.140, 0.02 * 1.140);
+
+  auto lame = run_pneumo("validate lame-sphere --cube-mm 10 --placements 1 --json");
+  ASSERT_EQ(lame.code, 0) << lame.err;
+  const auto j = nlohmann::json::parse(lame.out);
+  for (const char* key : {"u_inner_mm", "u_inner_analytic_mm", "u_outer_mm", "u_outer_analytic_mm", "rel_error_inner",
+                          "rel_error_outer", "u_inner_lattice_mm", "u_outer_lattice_mm", "rel_error_inner_lattice",
+                          "rel_error_outer_lattice"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_NEAR(j.at("u_inner_mm").get<double>() / j.at("u_inner_analytic_mm").get<double>() - 1.0,
+              j.at("rel_error_inner").get<double>(), 1e-12);
+
+  EXPECT_EQ(run_pneumo("validate lame-sphere --placements 0").code, 2);
+}

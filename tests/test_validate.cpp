@@ -39,7 +39,8 @@ TEST(ValidateLattice, AxialYoungsModulusIs1140) {
   }
 }
 
-/// Lamé at one cube size, computed once per test binary (the 2.5 mm sphere takes a second or two).
+/// Lamé at one cube size, computed once per test binary. Four placements of the sphere at 10 and 5 mm;
+/// one at 2.5 mm, where they agree within 0.1 % (measured: 0.8286–0.8289 mm inner) and each takes ~10 s.
 const LameResult& lame(double cube_mm) {
   static std::map<double, LameResult> cache;
   auto it = cache.find(cube_mm);
@@ -48,12 +49,13 @@ const LameResult& lame(double cube_mm) {
     const OneThread one_thread;
     LameOptions o;
     o.cube_mm = cube_mm;
+    o.placements = cube_mm >= 5.0 ? 4 : 1;
     it = cache.emplace(cube_mm, validate_lame_sphere(o)).first;
     const LameResult& r = it->second;
     std::printf("Lame %4.1f mm: u_inner %.4f mm, u_outer %.4f mm; vs nominal %+.2f %% / %+.2f %%; vs lattice "
-                "moduli %+.2f %% / %+.2f %%; %lld nodes, %lld steps, %.2f s\n",
+                "moduli %+.2f %% / %+.2f %%; %d placements, %lld nodes, %lld steps, %.2f s\n",
                 cube_mm, r.u_inner_mm, r.u_outer_mm, 100 * r.rel_error_inner, 100 * r.rel_error_outer,
-                100 * r.rel_error_inner_lattice, 100 * r.rel_error_outer_lattice, (long long)r.nodes,
+                100 * r.rel_error_inner_lattice, 100 * r.rel_error_outer_lattice, o.placements, (long long)r.nodes,
                 (long long)r.steps, r.wall_time_s);
   }
   return it->second;
@@ -70,36 +72,25 @@ TEST(ValidateLame, ClosedFormsThemselves) {
   EXPECT_NEAR(r.u_outer_lattice_mm, 0.330, 5e-4);
 }
 
-TEST(ValidateLame, WithinTenPercentOfNominal) {
-  // Compared: mean radial displacement of the inner and outer boundary nodes, for cubes of 10, 5 and 2.5 mm,
-  // against the nominal Lamé solution (0.873/0.357 mm). Tolerance ±10 %: the lattice converges to its own
-  // moduli, 7.5 % below nominal (§10), and coarse staircase spheres err by a few percent more.
-  for (double h : {10.0, 5.0, 2.5}) {
-    SCOPED_TRACE("cube " + std::to_string(h) + " mm");
-    const LameResult& r = lame(h);
-    EXPECT_LE(std::abs(r.rel_error_inner), 0.10);
-    EXPECT_LE(std::abs(r.rel_error_outer), 0.10);
-  }
-}
-
-TEST(ValidateLame, ConvergesToTheLatticeModuli) {
-  // Compared: the same means against Lamé with the lattice's own moduli (0.808/0.330 mm, §4). The
-  // error must fall each time the cube size halves (10 → 5 → 2.5 mm), as a discretisation error
-  // must, and at 2.5 mm be within 6 % (inner) and 3 % (outer).
+TEST(ValidateLame, ConvergesToTheLatticeModuliAndStaysNearNominal) {
+  // One test for both claims: each process computes its spheres again (ctest runs tests apart), and
+  // the 2.5 mm sphere takes ~10 s.
   //
-  // Known gap (issue 3 asks 6 %/3 % already at 5 mm; method.md §10 measured +5.2 %/+2.5 % there):
-  // this octant model gives +6.9 %/+3.6 % at 5 mm. The value depends on where the lattice's
-  // 5-tetrahedron pattern and the staircase surface fall relative to the sphere by about ±1 %: the
-  // same sphere meshed whole, centred on a node with the other pattern parity, gives +6.0 %/+3.7 %,
-  // and centred on a cube centre +5.1 %/+1.6 % (but then 10 mm cubes miss the nominal outer value by
-  // 11 %). The 5 mm values are printed, not asserted, until that is settled.
+  // (1) Compared: the mean radial displacement of the inner and outer boundary against the nominal Lamé
+  // solution (0.873/0.357 mm), for cubes of 10, 5 and 2.5 mm. Tolerance ±10 %: the lattice converges to
+  // its own moduli, 7.5 % below nominal (§10), and coarse staircase spheres err by a few percent more.
+  //
+  // (2) Compared: the same means against Lamé with the lattice's own moduli (0.808/0.330 mm, §4).
+  // Tolerance: within 6 % (inner) and 3 % (outer) for cubes of 5 mm or less, and the error falls each
+  // time the cube size halves (10 → 5 → 2.5 mm), as a discretisation error must (measured: +6.2/+4.5,
+  // +4.3/+2.9, +2.5/+1.4 %).
   const double sizes[3] = {10.0, 5.0, 2.5};
   for (int i = 0; i < 3; ++i) {
     SCOPED_TRACE("cube " + std::to_string(sizes[i]) + " mm");
     const LameResult& r = lame(sizes[i]);
-    std::printf("Lame %.1f mm: inner %+.2f %%, outer %+.2f %% against the lattice moduli\n", sizes[i],
-                100 * r.rel_error_inner_lattice, 100 * r.rel_error_outer_lattice);
-    if (sizes[i] <= 2.5) {
+    EXPECT_LE(std::abs(r.rel_error_inner), 0.10);
+    EXPECT_LE(std::abs(r.rel_error_outer), 0.10);
+    if (sizes[i] <= 5.0) {
       EXPECT_LE(std::abs(r.rel_error_inner_lattice), 0.06);
       EXPECT_LE(std::abs(r.rel_error_outer_lattice), 0.03);
     }
@@ -108,6 +99,33 @@ TEST(ValidateLame, ConvergesToTheLatticeModuli) {
       EXPECT_LT(std::abs(r.rel_error_inner_lattice), std::abs(coarse.rel_error_inner_lattice));
       EXPECT_LT(std::abs(r.rel_error_outer_lattice), std::abs(coarse.rel_error_outer_lattice));
     }
+  }
+}
+
+TEST(ValidateLame, PlacementsSpreadLittle) {
+  // Compared: the surface means of the four placements at 10 mm cubes against their average. Tolerance
+  // 2 %: area weighting removes most of the staircase's aliasing (measured spread 0.15 % inner,
+  // 0.9 % outer); a plain node mean at a node-centred placement was 3 % off the generic ones.
+  const LameResult& r = lame(10.0);
+  EXPECT_LE(r.u_inner_max_mm - r.u_inner_min_mm, 0.02 * r.u_inner_mm);
+  EXPECT_LE(r.u_outer_max_mm - r.u_outer_min_mm, 0.02 * r.u_outer_mm);
+  EXPECT_GT(r.u_inner_node_mean_mm, 0.0);
+}
+
+TEST(ValidateLame, PlacementsAreGenericAndSpread) {
+  // Compared: the R3 placements against the lattice's symmetric points (node and cube centre, where the
+  // staircase aligns with the sphere's axes and ties at r = a or b become possible): every coordinate in
+  // [0, 1) and at least 0.01 cubes from 0, ½ and 1; and against each other: any two differ by more than
+  // 0.2 cubes on some axis, so the four sample the cube rather than one corner of it.
+  for (int k = 0; k < 4; ++k) {
+    for (int a = 0; a < 3; ++a) {
+      const double c = lame_placement(k)[a];
+      EXPECT_GE(c, 0.0);
+      EXPECT_LT(c, 1.0);
+      for (double sym : {0.0, 0.5, 1.0}) EXPECT_GT(std::abs(c - sym), 0.01) << "placement " << k << " axis " << a;
+    }
+    for (int j = 0; j < k; ++j)
+      EXPECT_GT((lame_placement(k) - lame_placement(j)).cwiseAbs().maxCoeff(), 0.2) << k << " vs " << j;
   }
 }
 

@@ -1,6 +1,6 @@
-// Lamé's hollow sphere under internal pressure (method.md §10), on an octant with symmetry planes.
-#include <chrono>
+// Lamé's hollow sphere under internal pressure (method.md §10), meshed whole at several placements.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <set>
@@ -14,24 +14,43 @@ double lame_sphere_u(double r, double a, double b, double p, double bulk, double
   return p * a * a * a / (b * b * b - a * a * a) * (r / (3.0 * bulk) + b * b * b / (4.0 * shear * r * r));
 }
 
-LameResult validate_lame_sphere(const LameOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
-  // The sphere is voxelised at voxel_mm (each voxel by its centre) and meshed with cubes of
-  // cube_mm, exactly as the pipeline meshes a CT: a cube holding any shell voxel is a wall cube.
+Vec3 lame_placement(int k) {
+  // Roberts' R3 low-discrepancy sequence: placements spread evenly over the cube, none on a symmetry
+  // of the lattice (a node or a cube centre), where the staircase aligns with the sphere's axes.
+  const double g = 1.2207440846057594754;   // the real root of g⁴ = g + 1
+  const Vec3 alpha(1.0 / g, 1.0 / (g * g), 1.0 / (g * g * g));
+  Vec3 o;
+  for (int a = 0; a < 3; ++a) o[a] = std::fmod(0.5 + (k + 1) * alpha[a], 1.0);
+  return o;
+}
+
+namespace {
+
+struct PlacementMeans {
+  double inner_area = 0, outer_area = 0;   // surface means (mm)
+  double inner_node = 0, outer_node = 0;   // plain node means (mm)
+  int64_t nodes = 0, inner_nodes = 0, outer_nodes = 0, steps = 0;
+  double residual = 0;
+};
+
+PlacementMeans solve_placement(const LameOptions& o, const Vec3& offset_cubes) {
+  // The sphere is voxelised at voxel_mm (each voxel by its centre) and meshed with cubes of cube_mm,
+  // exactly as the pipeline meshes a CT: a cube holding any shell voxel is a wall cube.
   const double v = o.voxel_mm > 0.0 ? o.voxel_mm : o.cube_mm;
   const int L = int(std::lround(o.cube_mm / v));
   if (L < 1 || std::abs(L * v - o.cube_mm) > 1e-9 * o.cube_mm)
     throw std::invalid_argument("validate_lame_sphere: cube_mm must be a whole multiple of voxel_mm");
-  const int64_t nv = (int64_t(std::ceil(o.outer_mm / o.cube_mm)) + 1) * L;
+  const int64_t half = (int64_t(std::ceil(o.outer_mm / o.cube_mm)) + 1) * L;
   Geometry g;
-  g.dims = {nv, nv, nv};
+  g.dims = {2 * half, 2 * half, 2 * half};
   g.spacing_mm = Vec3::Constant(v);
-  g.origin_mm = Vec3::Constant(0.5 * v);   // lattice nodes at multiples of the cube size; centre at 0
+  // Lattice node (h, h, h) sits at −offset cubes from the sphere's centre (the world origin).
+  g.origin_mm = Vec3::Constant(0.5 * v - half * v) - offset_cubes * o.cube_mm;
   std::vector<Role> roles(g.voxel_count());
 #pragma omp parallel for schedule(static)
-  for (int64_t k = 0; k < nv; ++k)
-    for (int64_t j = 0; j < nv; ++j)
-      for (int64_t i = 0; i < nv; ++i) {
+  for (int64_t k = 0; k < g.dims[2]; ++k)
+    for (int64_t j = 0; j < g.dims[1]; ++j)
+      for (int64_t i = 0; i < g.dims[0]; ++i) {
         const double r = g.to_world(Vec3(i, j, k)).norm();
         // Inside the cavity: "viscera" so that the wall's inner faces are cavity triangles.
         roles[g.linear_index(i, j, k)] = r < o.inner_mm ? Role::Viscera : r <= o.outer_mm ? Role::Wall : Role::Other;
@@ -42,12 +61,12 @@ LameResult validate_lame_sphere(const LameOptions& o) {
   const double E = units::kpa_to_pa(o.young_kpa);
   Mesh m = build_mesh(VoxelRoles{g, roles.data(), nullptr}, mo, [&](Role, int) { return E; });
   assign_material(m, MaterialOptions{});
-  for (int64_t i = 0; i < m.node_count(); ++i)
-    for (int a = 0; a < 3; ++a)
-      if (m.node_lattice[i][a] == 0) m.hold[i] |= uint8_t(1 << a);   // symmetry planes
+  // Nothing is held: the pressure on the closed cavity has no net force, and a rigid drift has no
+  // mean radial component over a closed surface.
 
-  // Boundary nodes from the mesh itself: tetrahedron faces used once are on the boundary; those on
-  // a symmetry plane are not surfaces of the sphere; cavity triangles are the inner surface.
+  // Boundary triangles from the mesh itself: tetrahedron faces used once; cavity triangles are the
+  // inner surface, the rest the outer. Each node's share of its boundary's area (⅓ per triangle)
+  // makes Σ A_i u_i / Σ A_i the exact surface mean of the piecewise-linear displacement.
   std::map<std::array<int32_t, 3>, int> face_uses;
   for (const auto& t : m.tets)
     for (int f = 0; f < 4; ++f) {
@@ -60,15 +79,12 @@ LameResult validate_lame_sphere(const LameOptions& o) {
     std::sort(t.begin(), t.end());
     cavity.insert(t);
   }
-  std::vector<uint8_t> side(m.node_count(), 0);   // 1 inner, 2 outer
+  std::vector<double> area[2] = {std::vector<double>(m.node_count(), 0.0), std::vector<double>(m.node_count(), 0.0)};
   for (const auto& [key, uses] : face_uses) {
     if (uses != 1) continue;
-    bool on_plane = false;
-    for (int a = 0; a < 3; ++a)
-      on_plane |= m.node_lattice[key[0]][a] == 0 && m.node_lattice[key[1]][a] == 0 && m.node_lattice[key[2]][a] == 0;
-    if (on_plane) continue;
-    const uint8_t mark = cavity.count(key) ? 1 : 2;
-    for (int32_t n : key) side[n] |= mark;
+    const int s = cavity.count(key) ? 0 : 1;
+    const double A = 0.5 * (m.rest_m[key[1]] - m.rest_m[key[0]]).cross(m.rest_m[key[2]] - m.rest_m[key[0]]).norm();
+    for (int32_t n : key) area[s][n] += A / 3.0;
   }
 
   SolveOptions so;
@@ -78,26 +94,57 @@ LameResult validate_lame_sphere(const LameOptions& o) {
   so.max_steps = 500000;
   const SolveResult r = solve(m, so);
 
+  PlacementMeans out;
+  double sum_a[2] = {0, 0}, w_a[2] = {0, 0}, sum_n[2] = {0, 0};
+  int64_t count[2] = {0, 0};
+  for (int64_t i = 0; i < m.node_count(); ++i)
+    for (int s = 0; s < 2; ++s) {
+      if (area[s][i] == 0.0) continue;
+      const double u_mm = units::m_to_mm((r.x[i] - m.rest_m[i]).dot(m.rest_m[i].normalized())) / o.solve_fraction;
+      sum_a[s] += area[s][i] * u_mm;
+      w_a[s] += area[s][i];
+      sum_n[s] += u_mm;
+      ++count[s];
+    }
+  out.inner_area = sum_a[0] / std::max(w_a[0], 1e-300);
+  out.outer_area = sum_a[1] / std::max(w_a[1], 1e-300);
+  out.inner_node = sum_n[0] / std::max<int64_t>(count[0], 1);
+  out.outer_node = sum_n[1] / std::max<int64_t>(count[1], 1);
+  out.nodes = m.node_count();
+  out.inner_nodes = count[0];
+  out.outer_nodes = count[1];
+  out.steps = r.steps;
+  out.residual = r.residual;
+  return out;
+}
+
+}  // namespace
+
+LameResult validate_lame_sphere(const LameOptions& o) {
+  if (o.placements < 1) throw std::invalid_argument("validate_lame_sphere: placements must be at least 1");
+  const auto t0 = std::chrono::steady_clock::now();
   LameResult out;
   out.options = o;
-  // Means over the whole sphere's boundary nodes: an off-plane node of the octant stands for 8 mirror
-  // images, a node on one symmetry plane for 4, on two for 2: weight ½ per plane it lies on, so the
-  // octant's mean equals the whole sphere's (checked against a full-sphere model: same values).
-  double sum_in = 0, sum_out = 0, w_in = 0, w_out = 0;
-  for (int64_t i = 0; i < m.node_count(); ++i) {
-    if (!side[i]) continue;
-    const Vec3 radial = m.rest_m[i].normalized();
-    const double u = (r.x[i] - m.rest_m[i]).dot(radial) / o.solve_fraction;
-    double w = 1.0;
-    for (int a = 0; a < 3; ++a)
-      if (m.node_lattice[i][a] == 0) w *= 0.5;
-    if (side[i] & 1) { sum_in += w * u; w_in += w; ++out.inner_nodes; }
-    if (side[i] & 2) { sum_out += w * u; w_out += w; ++out.outer_nodes; }
+  out.u_inner_min_mm = out.u_outer_min_mm = HUGE_VAL;
+  out.u_inner_max_mm = out.u_outer_max_mm = -HUGE_VAL;
+  for (int k = 0; k < o.placements; ++k) {
+    const PlacementMeans p = solve_placement(o, lame_placement(k));
+    out.u_inner_mm += p.inner_area / o.placements;
+    out.u_outer_mm += p.outer_area / o.placements;
+    out.u_inner_node_mean_mm += p.inner_node / o.placements;
+    out.u_outer_node_mean_mm += p.outer_node / o.placements;
+    out.u_inner_min_mm = std::min(out.u_inner_min_mm, p.inner_area);
+    out.u_inner_max_mm = std::max(out.u_inner_max_mm, p.inner_area);
+    out.u_outer_min_mm = std::min(out.u_outer_min_mm, p.outer_area);
+    out.u_outer_max_mm = std::max(out.u_outer_max_mm, p.outer_area);
+    out.nodes = std::max(out.nodes, p.nodes);
+    out.inner_nodes = std::max(out.inner_nodes, p.inner_nodes);
+    out.outer_nodes = std::max(out.outer_nodes, p.outer_nodes);
+    out.steps = std::max(out.steps, p.steps);
+    out.residual = std::max(out.residual, p.residual);
   }
-  out.u_inner_mm = units::m_to_mm(sum_in / std::max(w_in, 1e-300));
-  out.u_outer_mm = units::m_to_mm(sum_out / std::max(w_out, 1e-300));
-  const double a = o.inner_mm, b = o.outer_mm, p = units::mmhg_to_pa(o.pressure_mmhg) * 1e-3;   // p in kPa·… mm
-  // In mm with E in kPa and p in kPa: u comes out in mm.
+  const double a = o.inner_mm, b = o.outer_mm;
+  const double p = units::mmhg_to_pa(o.pressure_mmhg) * 1e-3;   // kPa, with E in kPa and radii in mm: u in mm
   const double Ek = o.young_kpa;
   out.u_inner_analytic_mm = lame_sphere_u(a, a, b, p, Ek / 1.5, Ek / 2.5);   // ν = 1/4: K = E/1.5, G = E/2.5
   out.u_outer_analytic_mm = lame_sphere_u(b, a, b, p, Ek / 1.5, Ek / 2.5);
@@ -107,9 +154,6 @@ LameResult validate_lame_sphere(const LameOptions& o) {
   out.rel_error_outer = out.u_outer_mm / out.u_outer_analytic_mm - 1.0;
   out.rel_error_inner_lattice = out.u_inner_mm / out.u_inner_lattice_mm - 1.0;
   out.rel_error_outer_lattice = out.u_outer_mm / out.u_outer_lattice_mm - 1.0;
-  out.nodes = m.node_count();
-  out.steps = r.steps;
-  out.residual = r.residual;
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
@@ -122,6 +166,7 @@ nlohmann::json to_json(const LameResult& r) {
           {"young_kpa", r.options.young_kpa},
           {"pressure_mmhg", r.options.pressure_mmhg},
           {"solved_at_mmhg", r.options.pressure_mmhg * r.options.solve_fraction},
+          {"placements", r.options.placements},
           {"u_inner_mm", r.u_inner_mm},
           {"u_outer_mm", r.u_outer_mm},
           {"u_inner_analytic_mm", r.u_inner_analytic_mm},
@@ -134,6 +179,10 @@ nlohmann::json to_json(const LameResult& r) {
           {"u_outer_lattice_mm", r.u_outer_lattice_mm},
           {"rel_error_inner_lattice", r.rel_error_inner_lattice},
           {"rel_error_outer_lattice", r.rel_error_outer_lattice},
+          {"u_inner_range_mm", {r.u_inner_min_mm, r.u_inner_max_mm}},
+          {"u_outer_range_mm", {r.u_outer_min_mm, r.u_outer_max_mm}},
+          {"u_inner_node_mean_mm", r.u_inner_node_mean_mm},
+          {"u_outer_node_mean_mm", r.u_outer_node_mean_mm},
           {"nodes", r.nodes},
           {"inner_nodes", r.inner_nodes},
           {"outer_nodes", r.outer_nodes},
