@@ -20,7 +20,9 @@
 //                          says which ("memory-bound" or "compute-bound").
 //   other_cores            CPU (in cores) that other processes used while it ran: the machine is shared, and a run
 //                          with other_cores above ~0.1 is contended (discard it)
-//   nodes, springs, spring_slots   the mesh (spring_slots: the padded neighbour table's width on OpenCL)
+//   nodes, springs         the mesh
+//   spring_records_per_node  OpenCL: spring records the gather reads per node, padding included (blocks of 8
+//                          nodes of equal degree, see kernels/msd_forces.cl)
 //   working_set_mib        bytes_per_node_update × nodes: below the L3 (32 MiB here) the data can stay in cache
 //                          between passes, and the DRAM-triad roofline is then a conservative bound (a fraction
 //                          above 1 is possible)
@@ -33,14 +35,14 @@
 // neighbours lie within a few lattice planes of the node; an element pass reads each distinct vertex's state once).
 // A write counts once, as the triad counts it. They follow kernels/msd_forces.cl and msd_integrators.cl (state as
 // displacements u = x − x₀) and host/solve/forces.cpp; change them with the kernels.
-//   OpenCL, node_forces:  u, v (float4 each), mass (float), force written (float4), and the padded slot-major spring
-//                         table: spring_slots × (index, k, c: 4 B each; rest vector and length: float4) = 28 B per
-//                         slot, whole width (on the phantom meshes a node has 10.6 springs on average of 18 slots,
-//                         but degrees 3–18 are mixed along the node order, so 99 % of the table's cache lines are
-//                         touched). Pressure on: triangle_pressure reads each triangle's int4 and its vertices' u
-//                         and x₀ (float4 each) and writes its force (float4), which node_forces reads back, plus per
-//                         node the triangle table up to its −1 (4 B an entry). Volume term on: likewise per
-//                         tetrahedron (int4, vertices' u and x₀, 4 float4 forces written and read) and its table.
+//   OpenCL, node_forces:  u, v (float4 each), mass (float), its block's node id (int), force written (float4), and
+//                         the block records of the spring table: spring_records_per_node × (index, k, c, rest x, y,
+//                         z, length: 4 B each) = 28 B per record (a node has 10.6 springs on average on the phantom
+//                         meshes; blocks group equal degrees, so padding adds little). Pressure on:
+//                         triangle_pressure reads each triangle's int4 and its vertices' u and x₀ (float4 each) and
+//                         writes its force (float4), which node_forces reads back, plus per node its triangle
+//                         records (4 B each, counted as its degree + 1). Volume term on: likewise per tetrahedron
+//                         (int4, vertices' u and x₀, 4 float4 forces written and read) and its records.
 //   OpenCL, integrator:   explicit_step reads u, v, force, the hold mask (float4 each) and 1/m (float), writes u
 //                         and v: 100 B per node.
 //   CPU reference:        double Vec3 (24 B). Per spring: its 2 node ids, k, c, rest length, its force written and
@@ -92,7 +94,19 @@ constexpr int kStepsPerIteration = 10;                // explicit steps per time
 constexpr std::size_t kTriadBytes = 512ull << 20;     // per array, far beyond the 32 MiB L3 (as bench_foundation)
 constexpr int kTriadReps = 5;
 constexpr double kPeakF32PerCore = 115e9;             // platform.md: ~230 GFLOP/s float32 on 2 cores
-constexpr PhantomSize kSizes[] = {PhantomSize::Small, PhantomSize::Medium, PhantomSize::Large};
+/// The meshes: the three phantoms as their scenes mesh them (8–9 mm cubes: working sets of 14–34 MiB, about the
+/// 32 MiB L3), and the large phantom at 3 mm cubes (cube_voxels 4: ~0.9 M nodes, a working set of ~300 MiB), where
+/// the data cannot stay in cache and the DRAM roofline is the honest bound.
+struct Case {
+  PhantomSize phantom;
+  int cube_voxels;   // 0: the scene's
+  const char* name;
+  bool operator<(const Case& o) const { return std::string(name) < o.name; }
+};
+const Case kSizes[] = {{PhantomSize::Small, 0, "small"},
+                       {PhantomSize::Medium, 0, "medium"},
+                       {PhantomSize::Large, 0, "large"},
+                       {PhantomSize::Large, 4, "large_3mm"}};
 
 // ---- the meshes, built once per size as the pipeline builds them -------------------------------
 
@@ -103,9 +117,9 @@ struct MeshCase {
   std::vector<Vec3> x0, v0;   // a perturbed state: nothing trivially zero
 };
 
-const MeshCase& mesh_case(PhantomSize size) {
+const MeshCase& mesh_case(const Case& size) {
   static std::mutex mutex;
-  static std::map<PhantomSize, std::unique_ptr<MeshCase>> cache;
+  static std::map<Case, std::unique_ptr<MeshCase>> cache;
   std::lock_guard<std::mutex> lock(mutex);
   auto& slot = cache[size];
   if (slot) return *slot;
@@ -114,9 +128,10 @@ const MeshCase& mesh_case(PhantomSize size) {
   log::set_level(log::Level::Quiet);   // the phantom's scene names a few labels its CT lacks: a warning per size
   const auto t0 = Clock::now();
   auto c = std::make_unique<MeshCase>();
-  const Scene scene = parse_scene(nlohmann::json::parse(phantom_scene_json(size)), "");
+  Scene scene = parse_scene(nlohmann::json::parse(phantom_scene_json(size.phantom)), "");
+  if (size.cube_voxels > 0) scene.mesh.cube_voxels = size.cube_voxels;
   {
-    const Phantom ph = make_phantom(size);
+    const Phantom ph = make_phantom(size.phantom);
     const RoleVolume rv = assign_roles(scene, ph.ct, &ph.labels);
     c->mesh = build_scene_mesh(VoxelRoles{rv.geometry, rv.role.data(), rv.label.data()}, scene);
   }
@@ -136,7 +151,7 @@ const MeshCase& mesh_case(PhantomSize size) {
   const MeshStats& st = c->mesh.stats;
   std::fprintf(stderr, "[bench_solver] %s mesh: %lld nodes, %lld springs, %lld tetrahedra, %lld cavity triangles, "
                        "dt %.3g ms, pressure %.1f Pa (built in %.1f s)\n",
-               phantom_size_name(size), (long long)st.nodes, (long long)st.springs, (long long)st.tetrahedra,
+               size.name, (long long)st.nodes, (long long)st.springs, (long long)st.tetrahedra,
                (long long)st.cavity_triangles, c->dt_s * 1e3, c->model.pressure_pa,
                std::chrono::duration<double>(Clock::now() - t0).count());
   slot = std::move(c);
@@ -190,12 +205,11 @@ struct Cost {
   double bytes = 0.0, flops = 0.0;   // per node
 };
 
-/// Σ over nodes of min(degree + 1, slots): the entries a per-node loop over a padded table reads before its −1.
+/// Σ over nodes of (degree + 1): the entries of an element table a node's gather reads (its own and about one of
+/// padding).
 double table_reads(const Csr& c, int64_t nodes) {
-  int64_t slots = 1;
-  for (int64_t n = 0; n < nodes; ++n) slots = std::max(slots, c.end(n) - c.begin(n));
   double r = 0.0;
-  for (int64_t n = 0; n < nodes; ++n) r += double(std::min<int64_t>(c.end(n) - c.begin(n) + 1, slots));
+  for (int64_t n = 0; n < nodes; ++n) r += double(c.end(n) - c.begin(n) + 1);
   return r;
 }
 
@@ -208,9 +222,9 @@ double distinct_nodes(const std::vector<std::array<int32_t, K>>& elements, int64
   return double(std::count(seen.begin(), seen.end(), 1));
 }
 
-// FLOPs. OpenCL node_forces, one spring end (nonlinear, damped): du, dv, d = rest + du (9), length (6), direction
-// (3), elastic part (5), damper (9), sum into f (6).
-constexpr double kFlopsSpringEndCl = 38;
+// FLOPs. OpenCL node_forces, one spring record (nonlinear, damped; padding records compute too): du, dv, d = rest +
+// du (9), length (6), reciprocal and direction (4), elastic part (5), damper (9), sum into f (6).
+constexpr double kFlopsSpringEndCl = 39;
 // CPU reference: one evaluation per spring (d, length, direction, elastic part, damper: 29), then ± gathered at
 // both ends (3 each).
 constexpr double kFlopsSpringCpu = 29 + 6;
@@ -221,15 +235,16 @@ constexpr double kFlopsGravity = 3;
 constexpr double kFlopsIntegratorCpu = 13;      // dt/m, v += (dt/m) f, x += dt v
 constexpr double kFlopsIntegratorCl = 16;       // the same and the hold mask's multiply
 
-constexpr double kClSpringSlotBytes = 4 + 4 + 4 + 16;             // index, k, c, (rest vector, rest length)
+constexpr double kClSpringRecordBytes = 7 * 4;                    // index, k, c, rest x, y, z, length
 constexpr double kClIntegratorBytes = 3 * 16 + 16 + 4 + 2 * 16;   // u, v, f, hold mask, 1/m; u, v written
 constexpr double kCpuIntegratorBytes = 3 * 24 + 8 + 1 + 2 * 24;   // x, v, f, mass, hold; x, v written
 
-Cost cl_force_cost(const Mesh& m, const ForceModel& model, int spring_slots) {
+/// gathered: the share of node blocks node_forces runs on (1, or the blocks with a free node in a solver's step).
+Cost cl_force_cost(const Mesh& m, const ForceModel& model, double spring_records_per_node, double gathered) {
   const int64_t N = m.node_count();
-  const double S = double(m.springs.size()), R = double(m.cavity_tris.size()), T = double(m.tets.size());
-  double bytes = double(N) * (16 + 16 + 4 + 16 + spring_slots * kClSpringSlotBytes);
-  double flops = 2 * S * kFlopsSpringEndCl + double(N) * kFlopsGravity;
+  const double R = double(m.cavity_tris.size()), T = double(m.tets.size());
+  double bytes = double(N) * (gathered * (16 + 16 + 4 + 4 + 16) + spring_records_per_node * kClSpringRecordBytes);
+  double flops = double(N) * (spring_records_per_node * kFlopsSpringEndCl + kFlopsGravity);
   if (model.pressure_pa != 0.0 && R > 0) {
     const Adjacency a = Adjacency::of(m);
     bytes += R * (16 + 16 + 16) + 32 * distinct_nodes(m.cavity_tris, N) + 4 * table_reads(a.tris, N);
@@ -333,7 +348,7 @@ void with_threads(int threads, F&& fn) {
 
 // ---- CPU reference ------------------------------------------------------------------------------
 
-void BM_ForcesCpu(benchmark::State& state, PhantomSize size, int threads) {
+void BM_ForcesCpu(benchmark::State& state, const Case& size, int threads) {
   const MeshCase& mc = mesh_case(size);
   const double bw = native_bandwidth_gb_s(threads);
   const Mesh& m = mc.mesh;
@@ -360,7 +375,7 @@ void BM_ForcesCpu(benchmark::State& state, PhantomSize size, int threads) {
                   "CPU reference, double, " + std::to_string(threads) + " thread(s)");
 }
 
-void BM_ExplicitStepCpu(benchmark::State& state, PhantomSize size, int threads) {
+void BM_ExplicitStepCpu(benchmark::State& state, const Case& size, int threads) {
   const MeshCase& mc = mesh_case(size);
   const double bw = native_bandwidth_gb_s(threads);
   const Mesh& m = mc.mesh;
@@ -413,9 +428,9 @@ void BM_ExplicitStepCpu(benchmark::State& state, PhantomSize size, int threads) 
 // ---- OpenCL -------------------------------------------------------------------------------------
 
 /// The device's force evaluator for a size, uploaded once.
-ClForceEvaluator& cl_forces(ClDevice& dev, const ocl::DeviceInfo& info, PhantomSize size) {
+ClForceEvaluator& cl_forces(ClDevice& dev, const ocl::DeviceInfo& info, const Case& size) {
   static std::mutex mutex;
-  static std::map<std::pair<std::string, PhantomSize>, std::unique_ptr<ClForceEvaluator>> cache;
+  static std::map<std::pair<std::string, Case>, std::unique_ptr<ClForceEvaluator>> cache;
   std::lock_guard<std::mutex> lock(mutex);
   auto& slot = cache[{info.spec(), size}];
   if (!slot) {
@@ -426,7 +441,7 @@ ClForceEvaluator& cl_forces(ClDevice& dev, const ocl::DeviceInfo& info, PhantomS
   return *slot;
 }
 
-void BM_ForcesCl(benchmark::State& state, PhantomSize size, ocl::DeviceInfo info) {
+void BM_ForcesCl(benchmark::State& state, Case size, ocl::DeviceInfo info) {
   try {
     const MeshCase& mc = mesh_case(size);
     ClDevice& dev = cl_device(info);
@@ -445,23 +460,23 @@ void BM_ForcesCl(benchmark::State& state, PhantomSize size, ocl::DeviceInfo info
     const double evals = double(state.iterations()), N = double(mc.mesh.node_count());
     state.counters["force_evals_per_s"] = benchmark::Counter(evals, benchmark::Counter::kIsRate);
     state.counters["node_updates_per_s"] = benchmark::Counter(evals * N, benchmark::Counter::kIsRate);
-    state.counters["spring_slots"] = eval.spring_slots();
+    state.counters["spring_records_per_node"] = eval.spring_records_per_node();
     mesh_counters(state, mc.mesh);
-    report_roofline(state, mc.mesh, cl_force_cost(mc.mesh, mc.model, eval.spring_slots()), evals * N / seconds,
+    report_roofline(state, mc.mesh, cl_force_cost(mc.mesh, mc.model, eval.spring_records_per_node(), 1.0), evals * N / seconds,
                     dev.bandwidth_gb_s, cl_peak_flop_s(info), info.name + ", float32");
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
   }
 }
 
-void BM_ExplicitStepCl(benchmark::State& state, PhantomSize size, ocl::DeviceInfo info) {
+void BM_ExplicitStepCl(benchmark::State& state, Case size, ocl::DeviceInfo info) {
   try {
     const MeshCase& mc = mesh_case(size);
     ClDevice& dev = cl_device(info);
     // The stepper keeps its state on the device across calls of this function (the dynamics stay bounded: damped,
     // dt at half the stability limit).
     static std::mutex mutex;
-    static std::map<std::pair<std::string, PhantomSize>, std::unique_ptr<ClExplicitStepper>> cache;
+    static std::map<std::pair<std::string, Case>, std::unique_ptr<ClExplicitStepper>> cache;
     ClExplicitStepper* stepper;
     {
       std::lock_guard<std::mutex> lock(mutex);
@@ -469,7 +484,10 @@ void BM_ExplicitStepCl(benchmark::State& state, PhantomSize size, ocl::DeviceInf
       if (!slot) slot = std::make_unique<ClExplicitStepper>(*dev.ctx, mc.mesh, mc.model, mc.dt_s);
       stepper = slot.get();
     }
-    const int spring_slots = cl_forces(dev, info, size).spring_slots();   // the same tables the stepper builds
+    // The same tables the stepper builds; its steps gather the blocks with a free node only.
+    const ClForceEvaluator& tables = cl_forces(dev, info, size);
+    const auto free = ClForceEvaluator::Nodes::Free;
+    const double spring_records = tables.spring_records_per_node(free), gathered = tables.gathered_fraction(free);
     stepper->steps(2);   // warm every kernel (PoCL compiles at the first launch)
     stepper->finish();
     const CpuSample c0 = cpu_sample();
@@ -483,9 +501,10 @@ void BM_ExplicitStepCl(benchmark::State& state, PhantomSize size, ocl::DeviceInf
     const double steps = double(state.iterations()) * kStepsPerIteration, N = double(mc.mesh.node_count());
     state.counters["force_evals_per_s"] = benchmark::Counter(steps, benchmark::Counter::kIsRate);
     state.counters["node_updates_per_s"] = benchmark::Counter(steps * N, benchmark::Counter::kIsRate);
-    state.counters["spring_slots"] = spring_slots;
+    state.counters["spring_records_per_node"] = spring_records;
+    state.counters["gathered_fraction"] = gathered;
     mesh_counters(state, mc.mesh);
-    Cost cost = cl_force_cost(mc.mesh, mc.model, spring_slots);
+    Cost cost = cl_force_cost(mc.mesh, mc.model, spring_records, gathered);
     cost.bytes += kClIntegratorBytes;
     cost.flops += kFlopsIntegratorCl;
     report_roofline(state, mc.mesh, cost, steps * N / seconds, dev.bandwidth_gb_s, cl_peak_flop_s(info),
@@ -512,15 +531,15 @@ bool register_all() {
     return "opencl_" + std::to_string(d.platform_index) + "_" + std::to_string(d.device_index);
   };
   const auto finish = [](benchmark::internal::Benchmark* b) { b->UseRealTime()->Unit(benchmark::kMillisecond); };
-  for (const PhantomSize size : kSizes) {
-    const std::string sz = phantom_size_name(size);
+  for (const Case& size : kSizes) {
+    const std::string sz = size.name;
     for (const auto& [name, threads] : cpu)
       finish(benchmark::RegisterBenchmark(("BM_Forces/" + name + "/" + sz).c_str(), BM_ForcesCpu, size, threads));
     for (const auto& d : devices)
       finish(benchmark::RegisterBenchmark(("BM_Forces/" + cl_name(d) + "/" + sz).c_str(), BM_ForcesCl, size, d));
   }
-  for (const PhantomSize size : kSizes) {
-    const std::string sz = phantom_size_name(size);
+  for (const Case& size : kSizes) {
+    const std::string sz = size.name;
     for (const auto& [name, threads] : cpu)
       finish(benchmark::RegisterBenchmark(("BM_ExplicitStep/" + name + "/" + sz).c_str(), BM_ExplicitStepCpu, size,
                                           threads));

@@ -7,10 +7,41 @@
 // the world origin: a spring's error is ~ε·k·h instead of ~ε·k·|x|, ~50× smaller on a CT.
 //
 // Layout: node vectors are float4 (x, y, z, unused) so every load is one aligned 16-byte access.
-// Per-node neighbour tables are padded to the mesh's largest degree and stored slot-major
-// (table[slot * n_nodes + node]), so neighbouring work-items read neighbouring addresses in every
-// slot (coalesced on a GPU, contiguous vectors on PoCL). An entry of −1 ends a node's list.
-// Every force is gathered per node in a fixed order: no atomics, the same bits every run.
+// The per-node gather works on blocks of W nodes (W = 8 or 16, a build option), one block per
+// work-item, with every quantity a floatW over the block's nodes: the arithmetic (sqrt, divide) is
+// explicitly SIMD, which PoCL's implicit vectoriser does not manage for loops with per-node trip
+// counts, and on a GPU a block is simply a wider work-item. Blocks group nodes of equal degree (the
+// host sorts them), so a block's neighbour records are as many as its nodes' springs, not the
+// mesh's largest degree: on the 5-tetrahedron lattice degrees alternate 18 and 6 node by node.
+// A record holds slot s of the block's W nodes contiguously: the other ends, k, c, and the rest
+// vector x₀_i − x₀_j (x, y, z) and its length. Padding entries have k = c = 0 and point at the
+// node itself. Every force is gathered per node in a fixed order: no atomics, the same bits every run.
+
+#ifndef W
+#define W 8
+#endif
+#if W == 8
+typedef float8 floatW;
+typedef int8 intW;
+#define vloadW vload8
+#elif W == 16
+typedef float16 floatW;
+typedef int16 intW;
+#define vloadW vload16
+#else
+#error "W must be 8 or 16"
+#endif
+
+// (X, Y, Z)[l] = buf[idx[l]].xyz for the W lanes.
+#define GATHER3(buf, idx, X, Y, Z)                 \
+  do {                                             \
+    _Pragma("unroll") for (int l_ = 0; l_ < W; ++l_) { \
+      const float4 t_ = (buf)[((const int*)&(idx))[l_]]; \
+      ((float*)&(X))[l_] = t_.x;                   \
+      ((float*)&(Y))[l_] = t_.y;                   \
+      ((float*)&(Z))[l_] = t_.z;                   \
+    }                                              \
+  } while (0)
 
 // Gas pressure on each cavity triangle: F = −P·S·n/3 per vertex, S·n = ½(x_b − x_a)×(x_c − x_a).
 __kernel void triangle_pressure(__global const float4* restrict u, __global const float4* restrict rest_x,
@@ -51,52 +82,91 @@ __kernel void tet_volume(__global const float4* restrict u, __global const float
   tet_force[4 * t + 3] = (float4)(s * g3, 0.0f);
 }
 
-// The net force on each node: its springs and dampers (nonlinear, or Nimura's linear form), plus the
-// triangle and tetrahedron forces computed above, plus gravity.
-// spring_rest holds, per slot, the rest vector x₀_i − x₀_j (xyz) and its length (w).
+// The net force on each node of a block: its springs and dampers (nonlinear, or Nimura's linear
+// form), plus the triangle and tetrahedron forces computed above, plus gravity.
+// block_nodes: W node ids per block (−1 pads the last block). *_begin: per block, its first record
+// (records of block b: begin[b] … begin[b + 1] − 1). Element records index tri_force / tet_force,
+// whose last entry is a zero the padding points at.
 __kernel void node_forces(__global const float4* restrict u, __global const float4* restrict v,
-                          __global const float* restrict mass, const int n_nodes,
-                          __global const int* restrict spring_node, __global const float* restrict spring_k,
-                          __global const float* restrict spring_c, __global const float4* restrict spring_rest,
-                          const int spring_slots, const int linear_springs, const int damping,
-                          __global const float4* restrict tri_force, __global const int* restrict node_tri,
-                          const int tri_slots,
-                          __global const float4* restrict tet_force, __global const int* restrict node_tet,
-                          const int tet_slots,
+                          __global const float* restrict mass, const int n_blocks,
+                          __global const int* restrict block_nodes,
+                          __global const int* restrict spring_begin, __global const int* restrict spring_node,
+                          __global const float* restrict spring_k, __global const float* restrict spring_c,
+                          __global const float* restrict rest_x, __global const float* restrict rest_y,
+                          __global const float* restrict rest_z, __global const float* restrict rest_len,
+                          const int linear_springs, const int damping,
+                          __global const float4* restrict tri_force, __global const int* restrict tri_begin,
+                          __global const int* restrict node_tri, const int with_tris,
+                          __global const float4* restrict tet_force, __global const int* restrict tet_begin,
+                          __global const int* restrict node_tet, const int with_tets,
                           const float4 gravity, __global float4* restrict force) {
-  const int i = get_global_id(0);
-  if (i >= n_nodes) return;
-  const float3 ui = u[i].xyz, vi = v[i].xyz;
-  float3 f = gravity.xyz * mass[i];
-  for (int s = 0; s < spring_slots; ++s) {
-    const int e = s * n_nodes + i;
-    const int j = spring_node[e];
-    if (j < 0) break;
-    const float k = spring_k[e];
-    const float c = damping ? spring_c[e] : 0.0f;
-    const float4 rest = spring_rest[e];
-    const float3 du = ui - u[j].xyz;
-    const float3 dv = vi - v[j].xyz;
-    if (linear_springs) {
-      f += -k * du - c * dv;   // −k(d − d₀) with d − d₀ = u_i − u_j exactly
+  const int b = get_global_id(0);
+  if (b >= n_blocks) return;
+  const intW ids = vloadW(b, block_nodes);
+  const intW idl = max(ids, (intW)(0));
+  floatW uix, uiy, uiz, vix, viy, viz;
+  GATHER3(u, idl, uix, uiy, uiz);
+  if (damping) GATHER3(v, idl, vix, viy, viz);
+  floatW m;
+  _Pragma("unroll") for (int l = 0; l < W; ++l) ((float*)&m)[l] = mass[((const int*)&idl)[l]];
+  floatW fx = gravity.x * m, fy = gravity.y * m, fz = gravity.z * m;
+
+  const int s_end = spring_begin[b + 1];
+  for (int r = spring_begin[b]; r < s_end; ++r) {
+    const intW j = vloadW(r, spring_node);
+    const floatW k = vloadW(r, spring_k);
+    floatW ujx, ujy, ujz;
+    GATHER3(u, j, ujx, ujy, ujz);
+    const floatW dux = uix - ujx, duy = uiy - ujy, duz = uiz - ujz;
+    floatW dvx = 0.0f, dvy = 0.0f, dvz = 0.0f, c = 0.0f;
+    if (damping) {
+      floatW vjx, vjy, vjz;
+      GATHER3(v, j, vjx, vjy, vjz);
+      dvx = vix - vjx;
+      dvy = viy - vjy;
+      dvz = viz - vjz;
+      c = vloadW(r, spring_c);
+    }
+    if (linear_springs) {   // −k(d − d₀) − c·dv, with d − d₀ = u_i − u_j exactly
+      fx -= k * dux + c * dvx;
+      fy -= k * duy + c * dvy;
+      fz -= k * duz + c * dvz;
     } else {
-      const float3 d = rest.xyz + du;
-      const float len = length(d);
-      if (len > 0.0f) {
-        const float3 dir = d / len;
-        f += -k * (len - rest.w) * dir - c * dot(dv, dir) * dir;
-      }
+      const floatW dx = vloadW(r, rest_x) + dux, dy = vloadW(r, rest_y) + duy, dz = vloadW(r, rest_z) + duz;
+      const floatW len = sqrt(dx * dx + dy * dy + dz * dz);
+      // A zero-length spring has no direction and gives no force (as the CPU reference): e = 0.
+      const floatW inv = select((floatW)(0.0f), 1.0f / len, isgreater(len, (floatW)(0.0f)));
+      const floatW ex = dx * inv, ey = dy * inv, ez = dz * inv;
+      const floatW s = -k * (len - vloadW(r, rest_len)) - c * (dvx * ex + dvy * ey + dvz * ez);
+      fx += s * ex;
+      fy += s * ey;
+      fz += s * ez;
     }
   }
-  for (int s = 0; s < tri_slots; ++s) {
-    const int t = node_tri[s * n_nodes + i];
-    if (t < 0) break;
-    f += tri_force[t].xyz;
+  if (with_tris) {
+    const int t_end = tri_begin[b + 1];
+    for (int r = tri_begin[b]; r < t_end; ++r) {
+      const intW t = vloadW(r, node_tri);
+      floatW gx, gy, gz;
+      GATHER3(tri_force, t, gx, gy, gz);
+      fx += gx;
+      fy += gy;
+      fz += gz;
+    }
   }
-  for (int s = 0; s < tet_slots; ++s) {
-    const int t = node_tet[s * n_nodes + i];
-    if (t < 0) break;
-    f += tet_force[t].xyz;   // t indexes tet_force directly: 4·tet + vertex
+  if (with_tets) {
+    const int t_end = tet_begin[b + 1];
+    for (int r = tet_begin[b]; r < t_end; ++r) {
+      const intW t = vloadW(r, node_tet);   // indexes tet_force directly: 4·tet + vertex
+      floatW gx, gy, gz;
+      GATHER3(tet_force, t, gx, gy, gz);
+      fx += gx;
+      fy += gy;
+      fz += gz;
+    }
   }
-  force[i] = (float4)(f, 0.0f);
+  _Pragma("unroll") for (int l = 0; l < W; ++l) {
+    const int i = ((const int*)&ids)[l];
+    if (i >= 0) force[i] = (float4)(((float*)&fx)[l], ((float*)&fy)[l], ((float*)&fz)[l], 0.0f);
+  }
 }

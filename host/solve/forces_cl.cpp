@@ -9,6 +9,7 @@ namespace pneumo {
 namespace {
 
 constexpr std::size_t kLocal = 64;   // fixed work-group size: PoCL compiles once per (kernel, size)
+constexpr int kBlock = 8;            // nodes per work-item in node_forces (W in msd_forces.cl)
 
 std::size_t global_size(int64_t n) { return (std::size_t(n) + kLocal - 1) / kLocal * kLocal; }
 
@@ -18,13 +19,63 @@ int max_degree(const Csr& c, int64_t nodes) {
   return int(std::max<int64_t>(d, 1));
 }
 
-/// Slot-major padded table: out[slot * nodes + node] = value(node's slot-th entry), −1 past the end.
-template <class F>
-std::vector<int> padded_table(const Csr& c, int64_t nodes, int slots, F&& value) {
-  std::vector<int> t(std::size_t(slots) * nodes, -1);
-  for (int64_t n = 0; n < nodes; ++n)
-    for (int64_t e = c.begin(n); e < c.end(n); ++e) t[std::size_t(e - c.begin(n)) * nodes + n] = value(c.item[e]);
-  return t;
+int64_t degree(const Csr& c, int64_t n) { return c.end(n) - c.begin(n); }
+
+/// Nodes grouped into blocks of kBlock: nodes with a free axis first, fully held ones last (their
+/// blocks can be skipped when only free forces matter). Within windows of kWindow nodes in mesh
+/// (lattice) order, nodes are sorted by spring degree, then cavity-triangle and tetrahedron degree,
+/// so a block's nodes need about the same number of records while a pass still sweeps the lattice
+/// once: the neighbours a block gathers stay within a few lattice planes, in cache, on meshes far
+/// larger than the cache (a global sort would sweep it once per degree).
+std::vector<int> block_nodes(const Mesh& m, const Adjacency& adj, int64_t& free_blocks) {
+  constexpr std::size_t kWindow = 1024;
+  std::vector<int> free_nodes, held_nodes;
+  for (int64_t n = 0; n < m.node_count(); ++n) (m.hold[n] == kHoldAll ? held_nodes : free_nodes).push_back(int(n));
+  auto key = [&](int n) {
+    return std::array<int64_t, 3>{degree(adj.springs, n), degree(adj.tris, n), degree(adj.tets, n)};
+  };
+  std::vector<int> order;
+  for (std::vector<int>* part : {&free_nodes, &held_nodes}) {
+    for (std::size_t w = 0; w < part->size(); w += kWindow) {
+      const auto first = part->begin() + w, last = part->begin() + std::min(part->size(), w + kWindow);
+      std::stable_sort(first, last, [&](int a, int b) { return key(a) > key(b); });
+    }
+    order.insert(order.end(), part->begin(), part->end());
+    // Each part starts a block of its own: −1 pads its last block.
+    order.resize((order.size() + kBlock - 1) / kBlock * kBlock, -1);
+    if (part == &free_nodes) free_blocks = int64_t(order.size()) / kBlock;
+  }
+  return order;
+}
+
+/// Block-record tables of one adjacency: records begin[b] … begin[b + 1] − 1 are block b's, as
+/// many as its widest node's degree, each kBlock entries (one per lane).
+std::vector<int> block_begin(const Csr& c, const std::vector<int>& blocks) {
+  const int64_t n_blocks = int64_t(blocks.size()) / kBlock;
+  std::vector<int> begin(n_blocks + 1, 0);
+  for (int64_t b = 0; b < n_blocks; ++b) {
+    int64_t width = 0;
+    for (int l = 0; l < kBlock; ++l)
+      if (const int n = blocks[b * kBlock + l]; n >= 0) width = std::max(width, degree(c, n));
+    begin[b + 1] = begin[b] + int(width);
+  }
+  return begin;
+}
+
+/// Calls fill(entry, node, item) for each real entry and pad(entry, node) for each padding one
+/// (node: the lane's node, or node 0 for the lanes past the last node).
+template <class Fill, class Pad>
+void fill_block_table(const Csr& c, const std::vector<int>& blocks, const std::vector<int>& begin, Fill&& fill,
+                      Pad&& pad) {
+  for (std::size_t b = 0; b + 1 < begin.size(); ++b)
+    for (int r = begin[b]; r < begin[b + 1]; ++r)
+      for (int l = 0; l < kBlock; ++l) {
+        const int n = blocks[b * kBlock + l];
+        const std::size_t entry = std::size_t(r) * kBlock + l;
+        const int64_t slot = r - begin[b];
+        if (n >= 0 && slot < degree(c, n)) fill(entry, n, c.item[c.begin(n) + slot]);
+        else pad(entry, std::max(n, 0));
+      }
 }
 
 template <class T>
@@ -46,42 +97,72 @@ std::vector<cl_float4> to_float4(const std::vector<Vec3>& v) {
 ClForceEvaluator::ClForceEvaluator(ocl::Context& ctx, const Mesh& m, uint64_t extra_bytes_per_node)
     : ctx_(ctx), nodes_(m.node_count()), tris_(int64_t(m.cavity_tris.size())), tets_(int64_t(m.tets.size())) {
   const Adjacency adj = Adjacency::of(m);
-  spring_slots_ = max_degree(adj.springs, nodes_);
-  tri_slots_ = max_degree(adj.tris, nodes_);
-  tet_slots_ = max_degree(adj.tets, nodes_);
+  const std::vector<int> blocks = block_nodes(m, adj, free_blocks_);
+  blocks_ = int64_t(blocks.size()) / kBlock;
   {
     // Everything below, before any of it is allocated: node state (u, v, x₀, F: float4; mass), the
-    // spring table (index, k, c: 4 bytes each; rest vector: 16 per slot), triangles and their
-    // forces, tetrahedra and their 4 vertex forces, the two padded element tables.
-    const uint64_t N = uint64_t(nodes_), T = uint64_t(tets_), R = uint64_t(tris_);
-    const uint64_t spring_table = uint64_t(spring_slots_) * N;
-    const uint64_t total = N * (4 * 16 + 4 + extra_bytes_per_node) + spring_table * 28 + R * 32 +
-                           uint64_t(tri_slots_) * N * 4 + T * (16 + 64) + uint64_t(tet_slots_) * N * 4;
-    const uint64_t largest = std::max({spring_table * 16, T * 64, N * 16});
+    // block tables (the block's nodes; per record and lane: spring end, k, c, rest x/y/z/length:
+    // 28 bytes; triangle or tetrahedron index: 4 bytes), triangles and tetrahedra and their forces.
+    // The records are bounded by the widest block's: at most max degree per node.
+    const uint64_t N = uint64_t(blocks.size()), T = uint64_t(tets_), R = uint64_t(tris_);
+    const uint64_t spring_entries = uint64_t(max_degree(adj.springs, nodes_)) * N;
+    const uint64_t total = N * (4 * 16 + 4 + 4 + extra_bytes_per_node) + spring_entries * 28 + R * 32 +
+                           uint64_t(max_degree(adj.tris, nodes_)) * N * 4 + T * (16 + 64) +
+                           uint64_t(max_degree(adj.tets, nodes_)) * N * 4;
+    const uint64_t largest = std::max({spring_entries * 4, T * 64, N * 16});
     ctx.check_fits(total, largest, "this mesh (" + std::to_string(nodes_) + " nodes)");
   }
 
-  // Springs seen from each node: the other end, and the spring's constants.
-  const std::vector<int> spring_of = padded_table(adj.springs, nodes_, spring_slots_, [](int32_t it) { return it; });
-  std::vector<int> other(spring_of.size(), -1);
-  std::vector<float> k(spring_of.size(), 0.f), c(spring_of.size(), 0.f);
-  std::vector<cl_float4> rest(spring_of.size(), cl_float4{{0, 0, 0, 0}});
-  for (std::size_t e = 0; e < spring_of.size(); ++e) {
-    if (spring_of[e] < 0) continue;
-    const int s = spring_of[e] / 8, slot = spring_of[e] % 8;
-    other[e] = m.springs[s][1 - slot];
-    k[e] = float(m.spring_k[s]);
-    c[e] = float(m.spring_c[s]);
-    const Vec3 d0 = m.rest_m[m.springs[s][slot]] - m.rest_m[m.springs[s][1 - slot]];   // in double, then rounded
-    const Vec3 d0f = d0.cast<float>().cast<double>();
-    rest[e] = {{float(d0[0]), float(d0[1]), float(d0[2]), float(d0f.norm())}};
-  }
+  // Springs seen from each node: the other end, the spring's constants, the rest vector from the
+  // other end to this node (in double, then rounded) and the length of that rounded vector.
+  const std::vector<int> spring_begin = block_begin(adj.springs, blocks);
+  const std::size_t entries = std::size_t(spring_begin.back()) * kBlock;
+  std::vector<int> other(entries);
+  std::vector<float> k(entries), c(entries), rx(entries), ry(entries), rz(entries), rl(entries);
+  fill_block_table(
+      adj.springs, blocks, spring_begin,
+      [&](std::size_t e, int n, int32_t item) {
+        const int s = item / 8, slot = item % 8;
+        const int j = m.springs[s][1 - slot];
+        other[e] = j;
+        k[e] = float(m.spring_k[s]);
+        c[e] = float(m.spring_c[s]);
+        const Vec3 d0 = m.rest_m[n] - m.rest_m[j];
+        rx[e] = float(d0[0]);
+        ry[e] = float(d0[1]);
+        rz[e] = float(d0[2]);
+        rl[e] = float(d0.cast<float>().cast<double>().norm());
+      },
+      [&](std::size_t e, int n) {
+        other[e] = n;
+        k[e] = c[e] = 0.0f;
+        rx[e] = rl[e] = 1.0f;   // a unit rest vector: finite arithmetic, zero force
+        ry[e] = rz[e] = 0.0f;
+      });
+  spring_begin_host_ = spring_begin;
+  block_nodes_ = upload(ctx, blocks);
+  spring_begin_ = upload(ctx, spring_begin);
   spring_node_ = upload(ctx, other);
   spring_k_ = upload(ctx, k);
   spring_c_ = upload(ctx, c);
-  spring_rest_ = upload(ctx, rest);
-  node_tri_ = upload(ctx, padded_table(adj.tris, nodes_, tri_slots_, [](int32_t it) { return it / 8; }));
-  node_tet_ = upload(ctx, padded_table(adj.tets, nodes_, tet_slots_, [](int32_t it) { return 4 * (it / 8) + it % 8; }));
+  spring_rest_[0] = upload(ctx, rx);
+  spring_rest_[1] = upload(ctx, ry);
+  spring_rest_[2] = upload(ctx, rz);
+  spring_rest_[3] = upload(ctx, rl);
+
+  // Element forces gathered per node; padding points at the zero entry past the last element.
+  auto element_table = [&](const Csr& csr, int zero_entry, auto&& index_of, cl::Buffer& begin_buf,
+                           cl::Buffer& table_buf) {
+    const std::vector<int> begin = block_begin(csr, blocks);
+    std::vector<int> table(std::size_t(begin.back()) * kBlock);
+    fill_block_table(
+        csr, blocks, begin, [&](std::size_t e, int, int32_t item) { table[e] = index_of(item); },
+        [&](std::size_t e, int) { table[e] = zero_entry; });
+    begin_buf = upload(ctx, begin);
+    table_buf = upload(ctx, table);
+  };
+  element_table(adj.tris, int(tris_), [](int32_t it) { return it / 8; }, tri_begin_, node_tri_);
+  element_table(adj.tets, int(4 * tets_), [](int32_t it) { return 4 * (it / 8) + it % 8; }, tet_begin_, node_tet_);
 
   std::vector<cl_int4> tris(m.cavity_tris.size()), tets(m.tets.size());
   for (std::size_t t = 0; t < tris.size(); ++t)
@@ -96,17 +177,28 @@ ClForceEvaluator::ClForceEvaluator(ocl::Context& ctx, const Mesh& m, uint64_t ex
   rest_m_ = m.rest_m;
   x_ = upload(ctx, std::vector<cl_float4>(nodes_, cl_float4{{0, 0, 0, 0}}), CL_MEM_READ_WRITE);
   v_ = upload(ctx, std::vector<cl_float4>(nodes_, cl_float4{{0, 0, 0, 0}}), CL_MEM_READ_WRITE);
-  f_ = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(nodes_, 1) * sizeof(cl_float4));
-  tri_force_ = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(tris_, 1) * sizeof(cl_float4));
-  tet_force_ = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, std::max<std::size_t>(4 * tets_, 1) * sizeof(cl_float4));
-  // Zero the element forces once: a term that is switched off then adds exact zeros.
-  ctx.queue().enqueueFillBuffer(tri_force_, cl_float4{{0, 0, 0, 0}}, 0, std::max<std::size_t>(tris_, 1) * sizeof(cl_float4));
-  ctx.queue().enqueueFillBuffer(tet_force_, cl_float4{{0, 0, 0, 0}}, 0,
-                                std::max<std::size_t>(4 * tets_, 1) * sizeof(cl_float4));
+  // Zeroed: a free-nodes-only evaluation leaves the fully held nodes' entries as they are.
+  f_ = upload(ctx, std::vector<cl_float4>(nodes_, cl_float4{{0, 0, 0, 0}}), CL_MEM_READ_WRITE);
+  // One zero entry past the last element: the padding's target. Zeroed once, so a term that is
+  // switched off also adds exact zeros.
+  tri_force_ = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, std::size_t(tris_ + 1) * sizeof(cl_float4));
+  tet_force_ = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, std::size_t(4 * tets_ + 1) * sizeof(cl_float4));
+  ctx.queue().enqueueFillBuffer(tri_force_, cl_float4{{0, 0, 0, 0}}, 0, std::size_t(tris_ + 1) * sizeof(cl_float4));
+  ctx.queue().enqueueFillBuffer(tet_force_, cl_float4{{0, 0, 0, 0}}, 0, std::size_t(4 * tets_ + 1) * sizeof(cl_float4));
 
-  k_tri_ = ctx.kernel("msd_forces.cl", "triangle_pressure");
-  k_tet_ = ctx.kernel("msd_forces.cl", "tet_volume");
-  k_node_ = ctx.kernel("msd_forces.cl", "node_forces");
+  const std::string options = "-DW=" + std::to_string(kBlock);
+  k_tri_ = ctx.kernel("msd_forces.cl", "triangle_pressure", options);
+  k_tet_ = ctx.kernel("msd_forces.cl", "tet_volume", options);
+  k_node_ = ctx.kernel("msd_forces.cl", "node_forces", options);
+}
+
+double ClForceEvaluator::spring_records_per_node(Nodes which) const {
+  const int64_t records = which == Nodes::All ? spring_begin_host_.back() : spring_begin_host_[free_blocks_];
+  return double(records) * kBlock / double(std::max<int64_t>(nodes_, 1));
+}
+
+double ClForceEvaluator::gathered_fraction(Nodes which) const {
+  return which == Nodes::All ? 1.0 : double(free_blocks_) / double(std::max<int64_t>(blocks_, 1));
 }
 
 void ClForceEvaluator::upload_state(const std::vector<Vec3>& x, const std::vector<Vec3>& v) {
@@ -117,7 +209,7 @@ void ClForceEvaluator::upload_state(const std::vector<Vec3>& x, const std::vecto
   if (!v.empty()) q.enqueueWriteBuffer(v_, CL_TRUE, 0, nodes_ * sizeof(cl_float4), to_float4(v).data());
 }
 
-void ClForceEvaluator::evaluate(const ForceModel& model) {
+void ClForceEvaluator::evaluate(const ForceModel& model, Nodes which) {
   auto& q = ctx_.queue();
   const bool pressure = model.pressure_pa != 0.0 && tris_ > 0, volume = model.volume_stiffness_pa != 0.0;
   if (pressure) {
@@ -128,13 +220,15 @@ void ClForceEvaluator::evaluate(const ForceModel& model) {
     ocl::set_args(k_tet_, x_, rest_x_, tets_buf_, float(model.volume_stiffness_pa), cl_int(tets_), tet_force_);
     q.enqueueNDRangeKernel(k_tet_, cl::NullRange, cl::NDRange(global_size(tets_)), cl::NDRange(kLocal));
   }
-  ocl::set_args(k_node_, x_, v_, mass_, cl_int(nodes_), spring_node_, spring_k_, spring_c_, spring_rest_,
-                cl_int(spring_slots_), cl_int(model.spring_model == SpringModel::Linear), cl_int(model.damping),
-                tri_force_, node_tri_, cl_int(pressure ? tri_slots_ : 0), tet_force_, node_tet_,
-                cl_int(volume ? tet_slots_ : 0),
+  const int64_t blocks = which == Nodes::All ? blocks_ : free_blocks_;
+  ocl::set_args(k_node_, x_, v_, mass_, cl_int(blocks), block_nodes_, spring_begin_, spring_node_, spring_k_,
+                spring_c_, spring_rest_[0], spring_rest_[1], spring_rest_[2], spring_rest_[3],
+                cl_int(model.spring_model == SpringModel::Linear), cl_int(model.damping), tri_force_, tri_begin_,
+                node_tri_, cl_int(pressure), tet_force_, tet_begin_, node_tet_, cl_int(volume),
                 cl_float4{{float(model.gravity_m_s2[0]), float(model.gravity_m_s2[1]), float(model.gravity_m_s2[2]), 0.0f}},
                 f_);
-  q.enqueueNDRangeKernel(k_node_, cl::NullRange, cl::NDRange(global_size(nodes_)), cl::NDRange(kLocal));
+  if (blocks > 0)
+    q.enqueueNDRangeKernel(k_node_, cl::NullRange, cl::NDRange(global_size(blocks)), cl::NDRange(kLocal));
 }
 
 std::vector<Vec3> ClForceEvaluator::download_positions(cl::Buffer& u) {

@@ -117,7 +117,7 @@ SolveResult explicit_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& op
   while (step < opt.max_steps) {
     const double t = step * dt;
     model.pressure_pa = opt.forces.pressure_pa * ramp_factor(t, opt.ramp_s, opt.ramp_shape);
-    d.eval.evaluate(model);
+    d.eval.evaluate(model, ClForceEvaluator::Nodes::Free);
     d.run(step_k);
     ++step;
     if (step % opt.monitor_every != 0 && step != opt.max_steps) continue;
@@ -167,7 +167,7 @@ SolveResult newmark_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt
     detail::NewmarkInnerLoop inner(opt.newmark_inner_tolerance, kNoiseFloor);
     for (int k = 0; k < opt.newmark_max_inner; ++k) {
       d.run(trial);
-      d.eval.evaluate(model);
+      d.eval.evaluate(model, ClForceEvaluator::Nodes::Free);
       ++evaluations;
       const auto red = d.reduce(accel, false);
       ++r.inner_iterations;
@@ -206,13 +206,13 @@ SolveResult kitasaka_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& op
   double residual = INFINITY;
   std::string reason;
   while (step < opt.max_steps) {
-    d.eval.evaluate(model);
+    d.eval.evaluate(model, ClForceEvaluator::Nodes::Free);
     ++evaluations;
     const double moved = d.reduce(step_k, true)[0];
     ++step;
     const bool done = moved < opt.kitasaka_tolerance_m;
     if (!done && step % opt.monitor_every != 0 && step != opt.max_steps) continue;
-    d.eval.evaluate(model);   // forces at the new positions, for the residual
+    d.eval.evaluate(model, ClForceEvaluator::Nodes::Free);   // forces at the new positions, for the residual
     ++evaluations;
     const auto o = d.observe(d.eval.positions(), d.eval.velocities());
     mon.check_diverged(o.max_displacement, step, detail::kKitasakaAdvice);
@@ -249,7 +249,7 @@ SolveResult static_fire_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions&
   double residual = INFINITY;
   std::string reason;
   auto evaluate = [&] {
-    d.eval.evaluate(model);
+    d.eval.evaluate(model, ClForceEvaluator::Nodes::Free);
     d.run(mask);
     ++evaluations;
   };
@@ -327,7 +327,7 @@ ClExplicitStepper::ClExplicitStepper(ocl::Context& ctx, const Mesh& m, const For
 ClExplicitStepper::~ClExplicitStepper() { delete impl_; }
 void ClExplicitStepper::steps(int n) {
   for (int i = 0; i < n; ++i) {
-    impl_->d.eval.evaluate(impl_->model);
+    impl_->d.eval.evaluate(impl_->model, ClForceEvaluator::Nodes::Free);
     impl_->d.run(impl_->step_k);
   }
 }
