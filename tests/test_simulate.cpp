@@ -56,6 +56,35 @@ TEST(Simulate, PhantomAt12MmHgRisesOpensACavityAndKeepsFixedNodesStill) {
               "%lld steps\n", d.anterior_rise_mm, d.cavity_volume_ml, d.mean_viscera_anterior_mm, (long long)r.steps);
 }
 
+TEST(Simulate, PressureVolumeCurveGrowsAndEndsWhereADirectRunEnds) {
+  // Compared: the curve 0, 4, 8, 12 mmHg on the phantom (each pressure from the previous equilibrium)
+  // against physics and against a direct 12 mmHg run. The volume and the rise must grow with pressure
+  // (a stiffer-with-stretch wall: positive, increasing; 0 mmHg is the rest state, 0 ml); the 12 mmHg
+  // point must match the direct run's cavity volume within 1 % (both stop at the scene's residual 1e-3,
+  // whose displacement error is a fraction of a percent of the rise) and become the main result.
+  ScratchDir dir;
+  Scene scene = phantom_scene(dir);
+  const Simulation direct = simulate_scene(scene);
+  scene.load.pressure_curve_mmhg = {0.0, 4.0, 8.0};
+  const Simulation sim = simulate_scene(scene);
+  ASSERT_EQ(sim.pressure_curve.size(), 4u);
+  EXPECT_EQ(sim.pressure_curve[0].pressure_mmhg, 0.0);
+  EXPECT_EQ(sim.pressure_curve[0].cavity_volume_ml, 0.0);
+  for (std::size_t i = 1; i < sim.pressure_curve.size(); ++i) {
+    const PressurePoint& p = sim.pressure_curve[i];
+    SCOPED_TRACE(std::to_string(p.pressure_mmhg) + " mmHg");
+    EXPECT_TRUE(p.converged);
+    EXPECT_GT(p.cavity_volume_ml, sim.pressure_curve[i - 1].cavity_volume_ml);
+    EXPECT_GT(p.anterior_rise_mm, sim.pressure_curve[i - 1].anterior_rise_mm);
+    std::printf("P-V %4.1f mmHg: %6.1f ml, rise %5.1f mm, %lld steps\n", p.pressure_mmhg, p.cavity_volume_ml,
+                p.anterior_rise_mm, (long long)p.steps);
+  }
+  const double v_direct = deformation_metrics(direct.mesh, direct.result.x).cavity_volume_ml;
+  EXPECT_NEAR(sim.pressure_curve.back().cavity_volume_ml, v_direct, 0.01 * v_direct);
+  EXPECT_NEAR(deformation_metrics(sim.mesh, sim.result.x).cavity_volume_ml, v_direct, 0.01 * v_direct);
+  EXPECT_EQ(simulation_metrics(scene, sim).at("pressure_curve").size(), 4u);
+}
+
 TEST(Simulate, WritesMeshesMetricsAndTheSceneUsed) {
   ScratchDir dir;
   Scene scene = phantom_scene(dir);

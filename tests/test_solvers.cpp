@@ -415,6 +415,40 @@ TEST(SolverEquilibrium, FourSolversAgreeWithKitasakasVolumeTerm) {
   expect_same_equilibrium(units::kpa_to_pa(s.effective_volume_stiffness_kpa()));
 }
 
+TEST(SolverEquilibrium, ContinuingFromAnEquilibriumReachesTheSameOne) {
+  // Compared: the equilibrium at 10 mmHg reached from rest, against the one reached from the 6 mmHg
+  // equilibrium with start_pressure_pa = 6 mmHg (how a pressure–volume curve steps), for the static and the
+  // explicit solver. Tolerance 1e-3 of the largest displacement: both runs stop at residual 1e-7 (static) or
+  // 1e-6 with 1e-8 m/s (explicit), far below it; a restart that re-applied the load from zero, or ignored
+  // the start state, would land elsewhere or take as long as from rest.
+  const OneThread one_thread;
+  const Mesh m = clamped_slab();
+  for (SolverMethod method : {SolverMethod::Static, SolverMethod::Explicit}) {
+    SCOPED_TRACE(enum_name(method));
+    SolveOptions o = quiet(method);
+    o.residual_tolerance = method == SolverMethod::Static ? 1e-7 : 1e-6;
+    o.velocity_tolerance_m_s = 1e-8;
+    o.max_steps = 400000;
+    o.forces.pressure_pa = units::mmhg_to_pa(10.0);
+    const SolveResult direct = solve(m, o);
+    SolveOptions half = o;
+    half.forces.pressure_pa = units::mmhg_to_pa(6.0);
+    const SolveResult first = solve(m, half);
+    SolveOptions rest = o;
+    rest.start_pressure_pa = half.forces.pressure_pa;
+    const SolveResult continued = solve(m, rest, first.x);
+    ASSERT_TRUE(direct.converged && first.converged && continued.converged);
+    double u_max = 0.0;
+    for (int64_t i = 0; i < m.node_count(); ++i) u_max = std::max(u_max, (direct.x[i] - m.rest_m[i]).norm());
+    EXPECT_LE(max_distance(direct.x, continued.x), 1e-3 * u_max);
+    EXPECT_NEAR(continued.final_pressure_pa, o.forces.pressure_pa, 1e-9);
+    if (method == SolverMethod::Static) {
+      // One 4 mmHg increment instead of three.
+      EXPECT_LT(continued.steps, direct.steps);
+    }
+  }
+}
+
 // ---- divergence -------------------------------------------------------------------------------------------------
 
 TEST(SolverDivergence, NewmarkBeyondItsStableStepThrows) {

@@ -1,5 +1,6 @@
 #include "pipeline/simulate.h"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <sstream>
@@ -44,14 +45,58 @@ Simulation simulate_scene(const Scene& scene) {
 
   t0 = std::chrono::steady_clock::now();
   const ocl::DeviceSpec device = ocl::parse_device_spec(scene.device);
+  std::shared_ptr<ocl::Context> ctx;
   if (device.use_opencl) {
-    auto ctx = ocl::Context::shared(device);
+    ctx = ocl::Context::shared(device);
     sim.device = ctx->info().spec() + " " + ctx->info().name;
     log::info("solving on " + sim.device);
-    sim.result = solve_opencl(*ctx, sim.mesh, solve_options_from_scene(scene));
   } else {
     sim.device = "cpu";
-    sim.result = solve(sim.mesh, solve_options_from_scene(scene));
+  }
+  auto run = [&](const SolveOptions& opt, const std::vector<Vec3>& x_start) {
+    return ctx ? solve_opencl(*ctx, sim.mesh, opt, x_start) : solve(sim.mesh, opt, x_start);
+  };
+  const SolveOptions base = solve_options_from_scene(scene);
+  if (scene.load.pressure_curve_mmhg.empty()) {
+    sim.result = run(base, {});
+  } else {
+    std::vector<double> pressures = scene.load.pressure_curve_mmhg;
+    pressures.push_back(scene.load.pressure_mmhg);
+    std::sort(pressures.begin(), pressures.end());
+    pressures.erase(std::unique(pressures.begin(), pressures.end()), pressures.end());
+    std::vector<Vec3> x = sim.mesh.rest_m;
+    double previous_pa = 0.0;
+    for (const double p_mmhg : pressures) {
+      log::info("pressure-volume curve: " + std::to_string(p_mmhg) + " mmHg");
+      SolveOptions opt = base;
+      opt.forces.pressure_pa = units::mmhg_to_pa(p_mmhg);
+      opt.start_pressure_pa = previous_pa;
+      PressurePoint point;
+      point.pressure_mmhg = p_mmhg;
+      if (opt.forces.pressure_pa == previous_pa) {   // already in equilibrium here (0 mmHg at rest)
+        point.converged = true;
+      } else {
+        SolveResult r = run(opt, x);
+        x = r.x;
+        point.converged = r.converged;
+        point.steps = r.steps;
+        point.residual = r.residual;
+        point.wall_time_s = r.wall_time_s;
+        if (p_mmhg == scene.load.pressure_mmhg) sim.result = std::move(r);
+      }
+      const DeformationMetrics d = deformation_metrics(sim.mesh, x);
+      point.cavity_volume_ml = d.cavity_volume_ml;
+      point.anterior_rise_mm = d.anterior_rise_mm;
+      sim.pressure_curve.push_back(point);
+      previous_pa = opt.forces.pressure_pa;
+    }
+    if (sim.result.x.empty()) {   // load.pressure_mmhg was 0: the rest state
+      sim.result.x = sim.mesh.rest_m;
+      sim.result.v.assign(sim.mesh.rest_m.size(), Vec3::Zero());
+      sim.result.converged = true;
+      sim.result.stop_reason = "converged";
+      sim.result.solver = enum_name(base.method);
+    }
   }
   sim.stage_seconds_solve = seconds_since(t0);
   return sim;
@@ -138,6 +183,14 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
                    {"fixed", sim.roles.volume_ml(Role::Fixed)}};
   j["stage_seconds"] = {{"roles", sim.stage_seconds_roles}, {"mesh", sim.stage_seconds_mesh},
                         {"solve", sim.stage_seconds_solve}};
+  if (!sim.pressure_curve.empty()) {
+    nlohmann::json curve = nlohmann::json::array();
+    for (const PressurePoint& p : sim.pressure_curve)
+      curve.push_back({{"pressure_mmhg", p.pressure_mmhg}, {"cavity_volume_ml", p.cavity_volume_ml},
+                       {"anterior_rise_mm", p.anterior_rise_mm}, {"converged", p.converged}, {"steps", p.steps},
+                       {"residual", p.residual}, {"wall_time_s", p.wall_time_s}});
+    j["pressure_curve"] = curve;
+  }
   return j;
 }
 
@@ -153,6 +206,14 @@ void write_simulation(const Scene& scene, const Simulation& sim, const std::stri
         << units::m_to_mm(h.max_displacement_m) << "," << units::m_to_mm(h.max_speed_m_s) << "\n";
   write_text_file_atomic(path("convergence.csv"), csv.str());
   write_text_file_atomic(path("scene_used.json"), scene.echo().dump(2) + "\n");
+  if (!sim.pressure_curve.empty()) {
+    std::ostringstream pv;
+    pv << "pressure_mmhg,cavity_volume_ml,anterior_rise_mm,converged,steps,residual\n";
+    for (const PressurePoint& p : sim.pressure_curve)
+      pv << p.pressure_mmhg << "," << p.cavity_volume_ml << "," << p.anterior_rise_mm << "," << p.converged << ","
+         << p.steps << "," << p.residual << "\n";
+    write_text_file_atomic(path("pressure_volume.csv"), pv.str());
+  }
   // metrics.json last: its presence says the run finished.
   write_text_file_atomic(path("metrics.json"), simulation_metrics(scene, sim).dump(2) + "\n");
 }

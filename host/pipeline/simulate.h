@@ -10,16 +10,25 @@
 
 namespace pneumo {
 
+/// One point of a pressure–volume curve: the equilibrium at one pressure, reached from the last.
+struct PressurePoint {
+  double pressure_mmhg = 0, cavity_volume_ml = 0, anterior_rise_mm = 0, residual = 0, wall_time_s = 0;
+  bool converged = false;
+  int64_t steps = 0;
+};
+
 struct Simulation {
   RoleVolume roles;
   Mesh mesh;
-  SolveResult result;
+  SolveResult result;                         // at the scene's load.pressure_mmhg
+  std::vector<PressurePoint> pressure_curve;  // when the scene lists pressures (§9), in order
   std::string device;   // "cpu" or "opencl:P:D <name>"
   double stage_seconds_roles = 0, stage_seconds_mesh = 0, stage_seconds_solve = 0;
 };
 
 /// Runs roles, mesh and the scene's solver on the scene's device (the CPU reference or OpenCL).
-/// A DivergedError propagates.
+/// With load.pressure_curve_mmhg, every listed pressure and load.pressure_mmhg are solved in
+/// increasing order, each from the previous equilibrium. A DivergedError propagates.
 Simulation simulate_scene(const Scene& scene);
 
 /// Plausibility measures of a solved mesh (method.md §9): displacements of the wall, the largest
@@ -35,8 +44,8 @@ DeformationMetrics deformation_metrics(const Mesh& m, const std::vector<Vec3>& x
 /// The metrics.json of a simulation (keys listed in docs and tests).
 nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim);
 
-/// Writes mesh_initial.vtu, mesh_deformed.vtu, metrics.json, convergence.csv and scene_used.json
-/// into `dir` (created if needed), each atomically.
+/// Writes mesh_initial.vtu, mesh_deformed.vtu, metrics.json, convergence.csv, scene_used.json and,
+/// with a pressure curve, pressure_volume.csv into `dir` (created if needed), each atomically.
 void write_simulation(const Scene& scene, const Simulation& sim, const std::string& dir);
 
 }  // namespace pneumo

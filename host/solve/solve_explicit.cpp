@@ -18,7 +18,7 @@ SolveResult solve_explicit(const Mesh& m, const SolveOptions& opt, std::vector<V
   std::string reason;
   while (step < opt.max_steps) {
     const double t = step * dt;
-    model.pressure_pa = opt.forces.pressure_pa * ramp_factor(t, opt.ramp_s, opt.ramp_shape);
+    model.pressure_pa = detail::ramped_pressure(opt, t);
     eval.evaluate(model, x, v, f);
     for (int64_t n = 0; n < m.node_count(); ++n) v[n] += dt / m.mass_kg[n] * f[n];
     detail::apply_holds(m, v);

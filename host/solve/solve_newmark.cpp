@@ -37,7 +37,7 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
   std::string reason;
   while (step < opt.max_steps) {
     const double t_next = (step + 1) * dt;
-    model.pressure_pa = opt.forces.pressure_pa * ramp_factor(t_next, opt.ramp_s, opt.ramp_shape);
+    model.pressure_pa = detail::ramped_pressure(opt, t_next);
     for (int64_t n = 0; n < N; ++n) {
       xp[n] = x[n] + dt * v[n] + (0.5 - beta) * dt * dt * a[n];
       vp[n] = v[n] + (1.0 - gamma) * dt * a[n];

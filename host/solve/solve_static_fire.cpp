@@ -35,7 +35,7 @@ SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vecto
   std::string reason = "step limit";
   const std::string advice = detail::kStaticAdvice;
   for (int inc = 1; inc <= increments && step < opt.max_steps; ++inc) {
-    model.pressure_pa = opt.forces.pressure_pa * double(inc) / increments;
+    model.pressure_pa = detail::increment_pressure(opt, inc, increments);
     const bool last = inc == increments;
     const double tol = opt.residual_tolerance * (last ? 1.0 : F::kIntermediateToleranceFactor);
     detail::FireControl fire;

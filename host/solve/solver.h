@@ -24,6 +24,9 @@ struct SolveOptions {
   double velocity_tolerance_m_s = 5e-4;
   int hold_steps = 50;               // convergence must hold this many consecutive steps
   double ramp_s = 0.5;               // pressure ramp duration (dynamic solvers)
+  // The pressure the start state is in equilibrium with: ramps and load increments run from it to
+  // forces.pressure_pa (a pressure–volume curve solves each pressure from the last equilibrium).
+  double start_pressure_pa = 0.0;
   RampShape ramp_shape = RampShape::Smooth;
   double newmark_beta = 0.25, newmark_gamma = 0.5;
   double newmark_inner_tolerance = 1e-6;

@@ -116,7 +116,7 @@ SolveResult explicit_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& op
   std::string reason;
   while (step < opt.max_steps) {
     const double t = step * dt;
-    model.pressure_pa = opt.forces.pressure_pa * ramp_factor(t, opt.ramp_s, opt.ramp_shape);
+    model.pressure_pa = detail::ramped_pressure(opt, t);
     d.eval.evaluate(model, ClForceEvaluator::Nodes::Free);
     d.run(step_k);
     ++step;
@@ -162,7 +162,7 @@ SolveResult newmark_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt
   std::string reason;
   while (step < opt.max_steps) {
     const double t_next = (step + 1) * dt;
-    model.pressure_pa = opt.forces.pressure_pa * ramp_factor(t_next, opt.ramp_s, opt.ramp_shape);
+    model.pressure_pa = detail::ramped_pressure(opt, t_next);
     d.run(predict);
     detail::NewmarkInnerLoop inner(opt.newmark_inner_tolerance, kNoiseFloor);
     for (int k = 0; k < opt.newmark_max_inner; ++k) {
@@ -254,7 +254,7 @@ SolveResult static_fire_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions&
     ++evaluations;
   };
   for (int inc = 1; inc <= increments && step < opt.max_steps; ++inc) {
-    model.pressure_pa = opt.forces.pressure_pa * double(inc) / increments;
+    model.pressure_pa = detail::increment_pressure(opt, inc, increments);
     const bool last = inc == increments;
     const double tol = opt.residual_tolerance * (last ? 1.0 : F::kIntermediateToleranceFactor);
     detail::FireControl fire;

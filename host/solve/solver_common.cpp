@@ -22,8 +22,17 @@ std::vector<double> fire_masses(const Mesh& m, const SolveOptions& opt) {
 }
 
 int load_increments(const SolveOptions& opt) {
-  const double target_mmhg = opt.forces.pressure_pa / units::kPaPerMmHg;
-  return std::max(1, int(std::ceil(std::abs(target_mmhg) / Fire::kMaxIncrementMmHg)));
+  const double change_mmhg = (opt.forces.pressure_pa - opt.start_pressure_pa) / units::kPaPerMmHg;
+  return std::max(1, int(std::ceil(std::abs(change_mmhg) / Fire::kMaxIncrementMmHg)));
+}
+
+double increment_pressure(const SolveOptions& opt, int increment, int increments) {
+  return opt.start_pressure_pa + (opt.forces.pressure_pa - opt.start_pressure_pa) * double(increment) / increments;
+}
+
+double ramped_pressure(const SolveOptions& opt, double t_s) {
+  return opt.start_pressure_pa +
+         (opt.forces.pressure_pa - opt.start_pressure_pa) * ramp_factor(t_s, opt.ramp_s, opt.ramp_shape);
 }
 
 std::vector<double> stiffness_sums(const Mesh& m) {

@@ -80,8 +80,12 @@ class NewmarkInnerLoop {
 
 /// FIRE's fictitious masses: each node's spring stiffness sum (plus the volume term's, when on).
 std::vector<double> fire_masses(const Mesh& m, const SolveOptions& opt);
-/// Number of load increments for the static solver.
+/// Number of load increments for the static solver (from start_pressure_pa to the target).
 int load_increments(const SolveOptions& opt);
+/// The pressure of load increment k of n (k = n: the target).
+double increment_pressure(const SolveOptions& opt, int increment, int increments);
+/// The dynamic schemes' pressure at time t: the ramp from start_pressure_pa to the target.
+double ramped_pressure(const SolveOptions& opt, double t_s);
 /// Each node's spring stiffness sum D_i (the 2004 scheme's scaling).
 std::vector<double> stiffness_sums(const Mesh& m);
 /// The time step the dynamic schemes use, recording it and the stable estimate in r.
