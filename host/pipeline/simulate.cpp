@@ -11,6 +11,7 @@
 #include "core/units.h"
 #include "cl/cl_runtime.h"
 #include "mesh/vtu_writer.h"
+#include "report/plot_svg.h"
 #include "solve/solver_cl.h"
 
 namespace pneumo {
@@ -194,6 +195,52 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   return j;
 }
 
+std::string convergence_plot_svg(const SolveResult& r) {
+  PlotSeries residual{"residual", {}, {}, "#d62728"}, displacement{"max displacement", {}, {}, "#1f77b4"},
+      pressure{"pressure", {}, {}, "#2ca02c"};
+  for (const auto& h : r.history) {
+    residual.x.push_back(double(h.step));
+    residual.y.push_back(h.residual);
+    displacement.x.push_back(double(h.step));
+    displacement.y.push_back(units::m_to_mm(h.max_displacement_m));
+    pressure.x.push_back(double(h.step));
+    pressure.y.push_back(h.pressure_pa / units::kPaPerMmHg);
+  }
+  PlotOptions a;
+  a.title = "Convergence (" + r.solver + ")";
+  a.x_label = "step";
+  a.y_label = "residual (net / pressure force)";
+  a.log_y = true;
+  a.height_px = 300;
+  PlotOptions b;
+  b.x_label = "step";
+  b.y_label = "max displacement (mm)";
+  b.height_px = 240;
+  PlotOptions c = b;
+  c.y_label = "pressure (mmHg)";
+  c.height_px = 200;
+  return stack_svg({line_plot_svg({residual}, a), line_plot_svg({displacement}, b), line_plot_svg({pressure}, c)});
+}
+
+std::string pressure_curve_plot_svg(const std::vector<PressurePoint>& curve) {
+  PlotSeries volume{"cavity volume", {}, {}, "#1f77b4", true}, rise{"anterior rise", {}, {}, "#ff7f0e", true};
+  for (const PressurePoint& p : curve) {
+    volume.x.push_back(p.pressure_mmhg);
+    volume.y.push_back(p.cavity_volume_ml);
+    rise.x.push_back(p.pressure_mmhg);
+    rise.y.push_back(p.anterior_rise_mm);
+  }
+  PlotOptions a;
+  a.title = "Pressure-volume curve";
+  a.x_label = "pressure (mmHg)";
+  a.y_label = "cavity volume (ml)";
+  PlotOptions b;
+  b.x_label = "pressure (mmHg)";
+  b.y_label = "anterior rise (mm)";
+  b.height_px = 300;
+  return stack_svg({line_plot_svg({volume}, a), line_plot_svg({rise}, b)});
+}
+
 void write_simulation(const Scene& scene, const Simulation& sim, const std::string& dir) {
   std::filesystem::create_directories(dir);
   const auto path = [&](const char* name) { return (std::filesystem::path(dir) / name).string(); };
@@ -205,6 +252,7 @@ void write_simulation(const Scene& scene, const Simulation& sim, const std::stri
     csv << h.step << "," << h.time_s << "," << h.pressure_pa / units::kPaPerMmHg << "," << h.residual << ","
         << units::m_to_mm(h.max_displacement_m) << "," << units::m_to_mm(h.max_speed_m_s) << "\n";
   write_text_file_atomic(path("convergence.csv"), csv.str());
+  write_text_file_atomic(path("convergence.svg"), convergence_plot_svg(sim.result));
   write_text_file_atomic(path("scene_used.json"), scene.echo().dump(2) + "\n");
   if (!sim.pressure_curve.empty()) {
     std::ostringstream pv;
@@ -213,6 +261,7 @@ void write_simulation(const Scene& scene, const Simulation& sim, const std::stri
       pv << p.pressure_mmhg << "," << p.cavity_volume_ml << "," << p.anterior_rise_mm << "," << p.converged << ","
          << p.steps << "," << p.residual << "\n";
     write_text_file_atomic(path("pressure_volume.csv"), pv.str());
+    write_text_file_atomic(path("pressure_volume.svg"), pressure_curve_plot_svg(sim.pressure_curve));
   }
   // metrics.json last: its presence says the run finished.
   write_text_file_atomic(path("metrics.json"), simulation_metrics(scene, sim).dump(2) + "\n");

@@ -44,8 +44,13 @@ DeformationMetrics deformation_metrics(const Mesh& m, const std::vector<Vec3>& x
 /// The metrics.json of a simulation (keys listed in docs and tests).
 nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim);
 
-/// Writes mesh_initial.vtu, mesh_deformed.vtu, metrics.json, convergence.csv, scene_used.json and,
-/// with a pressure curve, pressure_volume.csv into `dir` (created if needed), each atomically.
+/// Plots (SVG): residual, largest displacement and pressure against step; cavity volume and anterior
+/// rise against pressure.
+std::string convergence_plot_svg(const SolveResult& r);
+std::string pressure_curve_plot_svg(const std::vector<PressurePoint>& curve);
+
+/// Writes mesh_initial.vtu, mesh_deformed.vtu, metrics.json, convergence.csv/.svg, scene_used.json
+/// and, with a pressure curve, pressure_volume.csv/.svg into `dir` (created if needed), each atomically.
 void write_simulation(const Scene& scene, const Simulation& sim, const std::string& dir);
 
 }  // namespace pneumo
