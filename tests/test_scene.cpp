@@ -370,6 +370,26 @@ TEST(SceneRules, RoiBothOrNeitherAndOrdered) {
                   "mesh.roi_max_mm = [1.0,0.0,1.0] must exceed mesh.roi_min_mm");
 }
 
+TEST(SceneRules, LandmarksNamedOnceMeasuredInPairsAndAtLeastThree) {
+  // Compared: the messages for the rules of §9's evaluation: a name twice, a measurement without its
+  // partner, and fewer than the 3 measured points Horn's alignment needs; a valid list parses.
+  auto mark = [](const std::string& name, bool before, bool after) {
+    json m = {{"name", name}, {"ct_mm", {1, 2, 3}}};
+    if (before) m["measured_before_mm"] = {0, 0, 0};
+    if (after) m["measured_after_mm"] = {0, 1, 0};
+    return m;
+  };
+  EXPECT_CONTAINS(error_of({{"landmarks", {mark("a", false, false), mark("a", false, false)}}}),
+                  "landmarks[1].name = \"a\" is used twice (also landmarks[0])");
+  EXPECT_CONTAINS(error_of({{"landmarks", {mark("a", true, false)}}}),
+                  "landmarks[0] gives measured_before_mm without measured_after_mm");
+  EXPECT_CONTAINS(error_of({{"landmarks", {mark("a", true, true), mark("b", true, true), mark("c", false, false)}}}),
+                  "needs at least 3");
+  EXPECT_EQ(error_of({{"landmarks", {mark("a", true, true), mark("b", true, true), mark("c", true, true),
+                                     mark("port", false, false)}}}),
+            "");
+}
+
 TEST(SceneRules, CameraItemErrorsCarryTheIndex) {
   json j = full_scene();
   j["render"]["cameras"].push_back({{"name", "b"}, {"position_mm", {0, 0, 0}}, {"look_at_mm", {1, 0, 0}}, {"fov_deg", 200}});

@@ -206,6 +206,14 @@ struct SceneOutput {
   int64_t timelapse_every_steps = 0;  // 0 = off
 };
 
+/// A landmark for Nimura's evaluation (§9): where it is in the CT, and optionally where a tracker
+/// measured it on the patient before and after insufflation (the tracker's own frame).
+struct Landmark {
+  std::string name;
+  Vec3 ct_mm = Vec3::Zero();                    // world RAS+, the original CT
+  std::optional<Vec3> measured_before_mm, measured_after_mm;
+};
+
 // ---- the scene ---------------------------------------------------------------------------------
 
 struct Scene {
@@ -220,6 +228,7 @@ struct Scene {
   std::string device = "cpu";     // "cpu", "opencl" or "opencl:P:D"
   SceneRender render;
   SceneOutput output;
+  std::vector<Landmark> landmarks;
 
   std::string path;    // the scene file as given ("" when built in code)
   std::string folder;  // absolute folder relative paths were resolved against

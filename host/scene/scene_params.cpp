@@ -301,6 +301,18 @@ const Table<SceneOutput>& output_table() {
   return t;
 }
 
+const Table<Landmark>& landmark_table() {
+  static const Table<Landmark> t{
+      {"name", &Landmark::name, "", view_name(), "Names the landmark in the report."},
+      {"ct_mm", &Landmark::ct_mm, "mm", required(), "Its position in the original CT (world RAS+)."},
+      {"measured_before_mm", &Landmark::measured_before_mm, "mm", any(),
+       "Measured on the patient before insufflation, in the tracker's frame (§9); give both or neither."},
+      {"measured_after_mm", &Landmark::measured_after_mm, "mm", any(),
+       "Measured after insufflation, in the same tracker frame."},
+  };
+  return t;
+}
+
 }  // namespace
 
 const Table<Scene>& scene_table() {
@@ -318,6 +330,8 @@ const Table<Scene>& scene_table() {
        "Where to compute: the C++ reference or an OpenCL device (`pneumo devices` lists them)."},
       {"render", &Scene::render, render_table(), "Laparoscope views (§8)."},
       {"output", &Scene::output, output_table(), "What is written besides the scene echo."},
+      {"landmarks", &Scene::landmarks, landmark_table(), any().items(0, 1000),
+       "Points whose simulated motion is reported; with tracker measurements, compared with them (§9)."},
   };
   return t;
 }

@@ -107,6 +107,27 @@ void check_views(const SceneRender& r, const At& render) {
   }
 }
 
+// Landmarks: unique names; tracker measurements in pairs (before and after), and, when any are given,
+// at least 3, since Horn's alignment of the tracker frame to the CT needs 3 points not on a line.
+void check_landmarks(const std::vector<Landmark>& marks, const At& list) {
+  std::map<std::string, std::size_t> first;
+  std::size_t measured = 0;
+  for (std::size_t i = 0; i < marks.size(); ++i) {
+    const Landmark& m = marks[i];
+    const At at = list.item(i);
+    const auto [it, fresh] = first.emplace(m.name, i);
+    if (!fresh) at.child("name").fail_value(m.name, "is used twice (also " + list.item(it->second).path + ")");
+    if (m.measured_before_mm.has_value() != m.measured_after_mm.has_value())
+      at.fail(std::string("gives ") + (m.measured_before_mm ? "measured_before_mm" : "measured_after_mm") +
+              " without " + (m.measured_before_mm ? "measured_after_mm" : "measured_before_mm") +
+              "; give both or neither");
+    measured += m.measured_before_mm.has_value();
+  }
+  if (measured > 0 && measured < 3)
+    list.fail("has " + std::to_string(measured) + " landmark(s) with tracker measurements; aligning the tracker "
+              "frame to the CT (Horn) needs at least 3");
+}
+
 }  // namespace
 
 void validate_scene(const Scene& s, const ReadContext& ctx) {
@@ -115,6 +136,7 @@ void validate_scene(const Scene& s, const ReadContext& ctx) {
   check_roi(s.mesh, root.child("mesh"));
   check_label_young(s.material, root.child("material"));
   check_views(s.render, root.child("render"));
+  check_landmarks(s.landmarks, root.child("landmarks"));
 }
 
 }  // namespace pneumo::scene_detail
