@@ -103,6 +103,31 @@ TEST_P(SolverClVsRef, ReachesTheSameEquilibrium) {
   EXPECT_EQ(dev.inverted_tetrahedra, 0);
 }
 
+// Snapshots from the device: the same steps as the CPU reference shows for the same run (both monitor on
+// the same steps; 40 steps under the full load, no convergence), and positions within the N-steps bound
+// above (1e-4 of the displacement) of the reference's at each.
+TEST_P(SolverClVsRef, SnapshotsMatchTheReference) {
+  const Mesh m = slab();
+  SolveOptions o = options(method());
+  o.ramp_s = 0.0;
+  o.max_steps = 40;
+  o.kitasaka_tolerance_m = 1e-9;   // run all 40 steps (the default stops this small slab early)
+  o.snapshot_every_steps = 10;
+  std::vector<std::pair<int64_t, std::vector<Vec3>>> ref_shots, dev_shots;
+  SolveOptions ro = o, dop = o;
+  ro.on_snapshot = [&](const SolverSnapshot& s) { ref_shots.push_back({s.step, s.x}); };
+  dop.on_snapshot = [&](const SolverSnapshot& s) { dev_shots.push_back({s.step, s.x}); };
+  const SolveResult ref = solve(m, ro);
+  solve_opencl(*ctx(), m, dop);
+  ASSERT_GE(ref_shots.size(), 2u);
+  ASSERT_EQ(dev_shots.size(), ref_shots.size());
+  const double u = max_displacement(m, ref.x);
+  for (std::size_t i = 0; i < ref_shots.size(); ++i) {
+    EXPECT_EQ(dev_shots[i].first, ref_shots[i].first);
+    EXPECT_LE(max_distance(dev_shots[i].second, ref_shots[i].second), 1e-4 * u) << "snapshot " << i;
+  }
+}
+
 std::string name(const ::testing::TestParamInfo<std::tuple<std::string, SolverMethod>>& info) {
   return testing_support::spec_name(std::get<0>(info.param)) + "_" + enum_name(std::get<1>(info.param));
 }

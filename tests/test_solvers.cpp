@@ -449,6 +449,38 @@ TEST(SolverEquilibrium, ContinuingFromAnEquilibriumReachesTheSameOne) {
   }
 }
 
+TEST(SolverSnapshots, ShownEveryNStepsWithTheCurrentPositions) {
+  // Compared: the snapshots a solver shows against its own run: steps increasing, at least N apart and at
+  // most N + monitor_every (snapshots come at monitoring steps), as many as the run's length allows, the
+  // positions finite and moving towards the final state (the last snapshot nearer to it than the first).
+  const OneThread one_thread;
+  const Mesh m = clamped_slab();
+  for (SolverMethod method : {SolverMethod::Static, SolverMethod::Explicit, SolverMethod::Newmark,
+                              SolverMethod::Kitasaka2004}) {
+    SCOPED_TRACE(enum_name(method));
+    SolveOptions o = quiet(method);
+    o.forces.pressure_pa = units::mmhg_to_pa(10.0);
+    o.snapshot_every_steps = 40;
+    o.kitasaka_tolerance_m = 1e-9;   // the default (1 mm summed over nodes) stops this tiny slab after a step
+    std::vector<int64_t> steps;
+    std::vector<std::vector<Vec3>> states;
+    o.on_snapshot = [&](const SolverSnapshot& s) {
+      steps.push_back(s.step);
+      states.push_back(s.x);
+    };
+    const SolveResult r = solve(m, o);
+    ASSERT_GE(steps.size(), 2u) << r.steps << " steps";
+    for (std::size_t i = 1; i < steps.size(); ++i) {
+      EXPECT_GE(steps[i] - steps[i - 1], 1);
+      EXPECT_LE(steps[i] - steps[i - 1], o.snapshot_every_steps + o.monitor_every);
+    }
+    EXPECT_GE(int64_t(steps.size()), r.steps / (o.snapshot_every_steps + o.monitor_every));
+    for (const auto& x : states)
+      for (const auto& p : x) ASSERT_TRUE(p.allFinite());
+    EXPECT_LT(max_distance(states.back(), r.x), max_distance(states.front(), r.x));
+  }
+}
+
 // ---- divergence -------------------------------------------------------------------------------------------------
 
 TEST(SolverDivergence, NewmarkBeyondItsStableStepThrows) {

@@ -14,6 +14,13 @@
 
 namespace pneumo {
 
+/// The state a solver shows its observer (checkpoints, the inflation preview) at monitoring steps.
+struct SolverSnapshot {
+  int64_t step = 0;
+  double time_s = 0, pressure_pa = 0;   // time 0 for the static schemes
+  const std::vector<Vec3>& x;           // positions (m)
+};
+
 struct SolveOptions {
   SolverMethod method = SolverMethod::Static;
   ForceModel forces;                 // pressure_pa is the target pressure
@@ -36,6 +43,10 @@ struct SolveOptions {
   bool kitasaka_jacobi = false;        // CPU reference: all nodes from the same forces, as the device does
   OnInverted on_inverted = OnInverted::Continue;
   int64_t monitor_every = 10;        // convergence/inversion checks every N steps
+  // Called at the first monitoring step at or past every snapshot_every_steps steps (0: never).
+  // On a device the positions are downloaded for it; what it does is not timed as solving.
+  int64_t snapshot_every_steps = 0;
+  std::function<void(const SolverSnapshot&)> on_snapshot;
   bool progress = true;
 };
 

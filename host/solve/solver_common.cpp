@@ -172,6 +172,10 @@ bool Monitor::record(int64_t step, double time_s, double pressure_pa, double res
       eta = (std::log(opt_.residual_tolerance) - std::log(residual)) / rate * seconds_per_step;
   }
   progress_.update(step, detail, eta);
+  if (opt_.on_snapshot && opt_.snapshot_every_steps > 0 && step >= next_snapshot_) {
+    opt_.on_snapshot(SolverSnapshot{step, time_s, pressure_pa, positions()});
+    next_snapshot_ = (step / opt_.snapshot_every_steps + 1) * opt_.snapshot_every_steps;
+  }
   if (opt_.on_inverted == OnInverted::Stop) {
     r_.inverted_tetrahedra = count_inverted(m_, positions());
     return r_.inverted_tetrahedra > 0;

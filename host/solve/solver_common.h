@@ -147,6 +147,7 @@ class Monitor {
   SolveResult& r_;
   double ref_load_ = 1.0, extent_m_ = 1.0;
   int64_t held_steps_ = 0;
+  int64_t next_snapshot_ = 0;   // the first monitoring step at or past it shows a snapshot
   std::chrono::steady_clock::time_point start_;
   Progress progress_;
 };
