@@ -18,6 +18,7 @@ namespace pneumo::testing_support {
 struct CavityPhantom {
   double spacing_mm = 1.5;
   int n = 64;                       // voxels per axis
+  double k_spacing_mm = 0;          // > 0: anisotropic, this spacing along the third axis (same extent)
   double cavity_radius_mm = 35.0;   // centred on the world origin
   Vec3 organ_centre_mm = Vec3(0.0, -35.0, 0.0);
   double organ_radius_mm = 14.0;
@@ -31,13 +32,16 @@ inline double ramp(double signed_distance_mm, double width_mm) {
 /// Volume on an n³ grid centred on the origin, direction identity unless `direction` is given.
 inline RenderVolume make_cavity_phantom(const CavityPhantom& p = {}, const Mat3& direction = Mat3::Identity()) {
   RenderVolume v;
-  v.geometry.dims = {p.n, p.n, p.n};
-  v.geometry.spacing_mm = Vec3::Constant(p.spacing_mm);
+  const double sk = p.k_spacing_mm > 0 ? p.k_spacing_mm : p.spacing_mm;
+  const int nk = int(std::lround(p.n * p.spacing_mm / sk));
+  v.geometry.dims = {p.n, p.n, nk};
+  v.geometry.spacing_mm = Vec3(p.spacing_mm, p.spacing_mm, sk);
   v.geometry.direction = direction;
-  v.geometry.origin_mm = -direction * Vec3::Constant(0.5 * (p.n - 1) * p.spacing_mm);
+  v.geometry.origin_mm = -direction * Vec3(0.5 * (p.n - 1) * p.spacing_mm, 0.5 * (p.n - 1) * p.spacing_mm,
+                                           0.5 * (nk - 1) * sk);
   v.hu.resize(v.geometry.voxel_count());
   v.labels.resize(v.geometry.voxel_count());
-  for (int k = 0; k < p.n; ++k)
+  for (int k = 0; k < nk; ++k)
     for (int j = 0; j < p.n; ++j)
       for (int i = 0; i < p.n; ++i) {
         const Vec3 w = v.geometry.to_world(Vec3(i, j, k));
