@@ -108,7 +108,7 @@ void main() {
       k = max(k, int(ceil((t_exit - u_near) / u_step - j)) - 1);  // the loop's ++k lands on it
       continue;
     }
-    uint id = label_at(p);
+    uint id = (u_show_labels != 0 || u_hide_exterior != 0) ? label_at(p) : 0u;  // a fetch saved otherwise
     if (u_hide_exterior != 0 && id == kExteriorAir) continue;
     float h = hu_at(p);
     vec4 tf = texture(u_tf, vec2((h - u_tf_hu_min + 0.5) / u_tf_size, 0.5));
