@@ -13,3 +13,18 @@ function(pneumo_embed_kernels out_cpp kernel_root)
     COMMENT "Embedding OpenCL kernels"
     VERBATIM)
 endfunction()
+
+# The same for GLSL shaders (shaders/*.vert, *.frag): table pneumo::gl::embedded_shaders().
+function(pneumo_embed_shaders out_cpp shader_root)
+  set(sources ${ARGN})
+  string(REPLACE ";" "|" joined "${sources}")
+  add_custom_command(
+    OUTPUT ${out_cpp}
+    COMMAND ${CMAKE_COMMAND} -DOUT=${out_cpp} -DROOT=${shader_root} "-DSOURCES=${joined}"
+            -DHEADER=render/embedded_shaders.h -DNAMESPACE=pneumo::gl -DTYPE=EmbeddedShader
+            -DFUNC=embedded_shaders
+            -P ${CMAKE_CURRENT_SOURCE_DIR}/cmake/EmbedKernelsScript.cmake
+    DEPENDS ${sources} ${CMAKE_CURRENT_SOURCE_DIR}/cmake/EmbedKernelsScript.cmake
+    COMMENT "Embedding GLSL shaders"
+    VERBATIM)
+endfunction()

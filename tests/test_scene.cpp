@@ -179,14 +179,26 @@ TEST(SceneRoundTrip, EveryKeyChangesItsOwnValueOnly) {
   int serial = 0, tested = 0;
   for_each_key(scene_detail::scene_table(), base, json::json_pointer(), "",
                [&](const ParamInfo& p, const json::json_pointer& ptr, const std::string& path) {
-    const json value = other_value(p, base.at(ptr), ++serial);
+    json value = other_value(p, base.at(ptr), ++serial);
     if (value.is_null()) return;  // $schema_version: its default is its only value
+    // Transfer-function points come in pairs/quadruples and only with preset "custom".
+    if (path == "render.custom_opacity") value = json::array({-100.0, 0.0, 100.0, 1.0});
+    if (path == "render.custom_colour") value = json::array({0.0, 1.0, 0.0, 0.0});
     json changed = base;
     changed[ptr] = value;
-    json::json_pointer companion;  // a key that must change with this one
+    std::vector<json::json_pointer> companions;  // keys that must change with this one
     if (path == "render.ports[0].target_label") {
-      companion = ptr.parent_pointer() / "target_mm";
-      changed[companion] = nullptr;
+      companions.push_back(ptr.parent_pointer() / "target_mm");
+      changed[companions.back()] = nullptr;
+    }
+    if (path == "render.custom_opacity" || path == "render.custom_colour") {
+      const auto render = ptr.parent_pointer();
+      companions.push_back(render / "preset");
+      changed[companions.back()] = "custom";
+      const char* other = path == "render.custom_opacity" ? "custom_colour" : "custom_opacity";
+      companions.push_back(render / other);
+      changed[companions.back()] = path == "render.custom_opacity" ? json::array({0.0, 1.0, 0.0, 0.0})
+                                                                  : json::array({-100.0, 0.0, 100.0, 1.0});
     }
     SCOPED_TRACE(path + " = " + value.dump());
     const std::string err = error_of(changed);
@@ -195,7 +207,7 @@ TEST(SceneRoundTrip, EveryKeyChangesItsOwnValueOnly) {
     const json expected = p.kind == Kind::Path ? json("/cases/abdomen/" + value.get<std::string>()) : value;
     EXPECT_EQ(echo.at(ptr), expected);
     echo[ptr] = base.at(ptr);
-    if (!companion.empty()) echo[companion] = base.at(companion);
+    for (const auto& c : companions) echo[c] = base.at(c);
     EXPECT_EQ(echo, base) << "changing " << path << " changed other keys";
     ++tested;
   });

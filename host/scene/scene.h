@@ -30,7 +30,7 @@ enum class RampShape : uint8_t { Smooth, Linear };
 enum class SolverMethod : uint8_t { Static, Explicit, Newmark, Kitasaka2004 };
 enum class OnInverted : uint8_t { Continue, Stop };
 enum class Lens : uint8_t { Pinhole, Fisheye };
-enum class RenderPreset : uint8_t { Laparoscopic, CtSoftTissue, CtMuscle, CtAaa, CtAir };
+enum class RenderPreset : uint8_t { Laparoscopic, CtSoftTissue, CtMuscle, CtAaa, CtAir, Custom };
 
 /// How each enum's values are written in scene files, indexed by the value: the one place these
 /// names are spelled (the parser, the reference and enum_name() all read them from here).
@@ -60,8 +60,8 @@ template <> struct EnumNames<Lens> {
   static constexpr std::array<const char*, 2> names{"pinhole", "fisheye"};
 };
 template <> struct EnumNames<RenderPreset> {
-  static constexpr std::array<const char*, 5> names{"laparoscopic", "ct-soft-tissue", "ct-muscle",
-                                                    "ct-aaa", "ct-air"};
+  static constexpr std::array<const char*, 6> names{"laparoscopic", "ct-soft-tissue", "ct-muscle",
+                                                    "ct-aaa", "ct-air", "custom"};
 };
 
 /// The scene-file name of an enum value ("kitasaka2004", "ct-muscle", ...).
@@ -191,6 +191,12 @@ struct SceneRender {
   bool show_labels = true;
   double label_opacity = 0.5;
   double light_falloff_mm = 100.0;  // d0 of the headlight's 1/(1+(d/d0)²) (§8)
+  // Phong coefficients; VTK's defaults for volumes lit by a headlight (ambient low: the scope's
+  // own light is the only light in the abdomen).
+  double ambient = 0.15, diffuse = 0.85, specular = 0.25, shininess = 12.0;
+  // preset "custom": Slicer-style flat lists [HU, α, HU, α, ...] and [HU, r, g, b, ...].
+  std::vector<double> custom_opacity, custom_colour;
+  bool exterior_views = true;     // anterior and left views from outside with CT-Air (§8)
   std::vector<Camera> cameras;
   std::vector<Port> ports;
   std::vector<CameraPath> paths;

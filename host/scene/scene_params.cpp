@@ -48,6 +48,19 @@ bool is_nonzero_vec(const json& v) {
   return v[0].get<double>() != 0.0 || v[1].get<double>() != 0.0 || v[2].get<double>() != 0.0;
 }
 
+// Flat transfer-function point lists: [HU, v, HU, v, ...] with `stride` numbers per point.
+bool is_points(const json& v, std::size_t stride) {
+  if (v.size() % stride != 0) return false;
+  for (std::size_t i = 0; i < v.size(); i += stride) {
+    if (i > 0 && v[i].get<double>() < v[i - stride].get<double>()) return false;
+    for (std::size_t c = 1; c < stride; ++c)
+      if (!(v[i + c].get<double>() >= 0.0 && v[i + c].get<double>() <= 1.0)) return false;
+  }
+  return true;
+}
+bool is_opacity_points(const json& v) { return is_points(v, 2); }
+bool is_colour_points(const json& v) { return is_points(v, 4); }
+
 constexpr double kMaxLabel = 65535;  // label maps are read as up to 16-bit ids
 constexpr double kMaxKPa = 1e6;      // 1 GPa: above any soft tissue by far, below overflow worries
 
@@ -269,7 +282,18 @@ const Table<SceneRender>& render_table() {
       {"width", &SceneRender::width, "px", in(16, 8192), "Image width."},
       {"height", &SceneRender::height, "px", in(16, 8192), "Image height."},
       {"preset", &SceneRender::preset, "", any(),
-       "Transfer function (§8): \"laparoscopic\" (flesh tones, gas clear) or one of 3D Slicer's CT presets."},
+       "Transfer function (§8): \"laparoscopic\" (flesh tones, gas clear), one of 3D Slicer's CT presets, or "
+       "\"custom\" (the two lists below)."},
+      {"custom_opacity", &SceneRender::custom_opacity, "", any().rule("pairs [HU, opacity 0 to 1], HU non-decreasing", is_opacity_points),
+       "Preset \"custom\": opacity per 1 mm of ray at HU points, [HU, α, HU, α, ...]; linear between, constant beyond."},
+      {"custom_colour", &SceneRender::custom_colour, "", any().rule("quadruples [HU, r, g, b], components 0 to 1, HU non-decreasing", is_colour_points),
+       "Preset \"custom\": colours at HU points, [HU, r, g, b, ...]."},
+      {"ambient", &SceneRender::ambient, "", in(0, 1), "Phong ambient coefficient (light present without the headlight)."},
+      {"diffuse", &SceneRender::diffuse, "", in(0, 1), "Phong diffuse coefficient (headlight, CT gradient normals)."},
+      {"specular", &SceneRender::specular, "", in(0, 1), "Phong specular coefficient (white highlights)."},
+      {"shininess", &SceneRender::shininess, "", in(1, 1000), "Phong specular exponent."},
+      {"exterior_views", &SceneRender::exterior_views, "", any(),
+       "Also render the abdomen from outside (anterior and left) with CT-Air: the gas cavity as a surface (§8)."},
       {"step_fraction", &SceneRender::step_fraction, "", above(0, 0.5),
        "Ray step as a fraction of the smallest voxel spacing (§8: at most half)."},
       {"jitter", &SceneRender::jitter, "", any(), "Offset each ray's start randomly (hides wood-grain bands; images then vary)."},

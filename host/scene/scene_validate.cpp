@@ -71,9 +71,22 @@ void check_lens(const Optics& o, const At& optics) {
                                                   "(a fisheye allows 180)");
 }
 
+// Preset "custom" needs its points; other presets ignore them, which would surprise: say so.
+void check_transfer_function(const SceneRender& r, const At& render) {
+  const bool custom = r.preset == RenderPreset::Custom;
+  const bool given = !r.custom_opacity.empty() || !r.custom_colour.empty();
+  if (custom && (r.custom_opacity.empty() || r.custom_colour.empty()))
+    render.child("preset").fail_value("custom", "needs both render.custom_opacity and render.custom_colour");
+  if (!custom && given)
+    render.child("preset").fail_value(enum_name(r.preset), "ignores custom_opacity/custom_colour; set preset "
+                                                           "\"custom\" to use them");
+}
+
 void check_views(const SceneRender& r, const At& render) {
   std::map<std::string, std::string> names;  // name → path of the view that has it
   const auto claim = [&](const std::string& name, const At& view) {
+    if (r.exterior_views && name.rfind("exterior_", 0) == 0)
+      view.child("name").fail_value(name, "starts with \"exterior_\", kept for the exterior views");
     const auto [it, fresh] = names.emplace(name, view.path);
     if (!fresh)
       view.child("name").fail_value(name, "is used twice (also " + it->second + "); views name output files");
@@ -135,6 +148,7 @@ void validate_scene(const Scene& s, const ReadContext& ctx) {
   check_role_lists(s.roles, root.child("roles"));
   check_roi(s.mesh, root.child("mesh"));
   check_label_young(s.material, root.child("material"));
+  check_transfer_function(s.render, root.child("render"));
   check_views(s.render, root.child("render"));
   check_landmarks(s.landmarks, root.child("landmarks"));
 }

@@ -1,0 +1,41 @@
+#include <filesystem>
+
+#include "cli/commands.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "pipeline/render_scene.h"
+
+namespace pneumo::cli {
+
+Run add_render(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "render", "Render the laparoscope's views, ports, fly-throughs and exterior views of a scene into --out");
+  struct Opts { std::string scene, out, backend = "auto"; bool cpu = false; };
+  auto o = std::make_shared<Opts>();
+  cmd->add_option("scene", o->scene, "Scene .json")->required();
+  cmd->add_option("--out", o->out,
+                  "Output folder; renders its deformed_ct.nii.gz (from simulate) when present, else the scene's CT")
+      ->required();
+  cmd->add_option("--backend", o->backend, "Offscreen OpenGL: auto, egl-device, egl-surfaceless or osmesa");
+  cmd->add_flag("--cpu", o->cpu, "Render with the CPU reference ray caster instead of OpenGL (slow)");
+  return [=] {
+    const Scene scene = load_scene(o->scene);
+    RenderOptions opt;
+    opt.out_dir = o->out;
+    opt.backend = parse_gl_backend(o->backend);
+    opt.cpu_reference = o->cpu;
+    std::error_code ec;
+    std::filesystem::create_directories(o->out, ec);
+    if (ec) throw InputError(o->out + ": cannot create the output folder (" + ec.message() + ")");
+    check_writable_target((std::filesystem::path(o->out) / "render.json").string());
+    const RenderRun run = render_scene(scene, opt);
+    const auto& rj = run.report["render"];
+    std::printf("render: %d views and %d fly-through frames from %s (%s%s); results in %s\n", run.views, run.frames,
+                run.deformed ? "the deformed CT" : "the original CT", rj["renderer"].get<std::string>().c_str(),
+                rj.contains("gl_renderer") ? (", " + rj["gl_renderer"].get<std::string>()).c_str() : "",
+                o->out.c_str());
+    return 0;
+  };
+}
+
+}  // namespace pneumo::cli

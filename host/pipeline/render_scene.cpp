@@ -1,0 +1,282 @@
+#include "pipeline/render_scene.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "core/progress.h"
+#include "io/volume_io.h"
+#include "render/camera_path.h"
+#include "render/image_out.h"
+#include "render/ray_cast_gl.h"
+#include "render/ray_cast_ref.h"
+
+namespace pneumo {
+namespace fs = std::filesystem;
+namespace {
+
+nlohmann::json vec_json(const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+
+std::string show(const Vec3& v) {
+  char b[96];
+  std::snprintf(b, sizeof b, "[%.1f, %.1f, %.1f]", v.x(), v.y(), v.z());
+  return b;
+}
+
+RenderSettings settings_from_scene(const SceneRender& r, const Geometry& g) {
+  RenderSettings s;
+  s.tf = scene_transfer_function(r);
+  s.step_mm = r.step_fraction * g.spacing_mm.minCoeff();  // §8: at most half the smallest spacing
+  s.jitter = r.jitter;
+  s.show_labels = r.show_labels;
+  s.label_opacity = r.label_opacity;
+  s.ambient = r.ambient;
+  s.diffuse = r.diffuse;
+  s.specular = r.specular;
+  s.shininess = r.shininess;
+  s.light_falloff_mm = r.light_falloff_mm;
+  return s;
+}
+
+// The GL ray caster or the CPU reference behind one call.
+class Renderer {
+ public:
+  explicit Renderer(const RenderOptions& o) : cpu_(o.cpu_reference) {
+    if (!cpu_) gl_ = std::make_unique<GlRayCaster>(shared_gl_context(o.backend));
+  }
+  void set_volume(const RenderVolume& v) {
+    volume_ = &v;
+    if (gl_) gl_->set_volume(v);
+  }
+  RenderImage render(const ViewCamera& c, const RenderSettings& s) {
+    return gl_ ? gl_->render(c, s) : render_reference(*volume_, c, s);
+  }
+  nlohmann::json describe() const {
+    if (!gl_) return {{"renderer", "cpu-reference"}};
+    const GlContextInfo& i = shared_gl_context().info();
+    return {{"renderer", "opengl"},        {"backend", gl_backend_name(i.backend)}, {"gl_version", i.version},
+            {"gl_renderer", i.renderer},   {"gl_vendor", i.vendor},                 {"hu_texture", gl_->hu_format()}};
+  }
+
+ private:
+  bool cpu_;
+  std::unique_ptr<GlRayCaster> gl_;
+  const RenderVolume* volume_ = nullptr;
+};
+
+void require_inside(const RenderVolume& v, const Vec3& tip, const std::string& what) {
+  if (v.contains(tip)) return;
+  const Geometry& g = v.geometry;
+  const Vec3 a = g.to_world(Vec3::Zero());
+  const Vec3 b = g.to_world(Vec3(double(g.dims[0] - 1), double(g.dims[1] - 1), double(g.dims[2] - 1)));
+  throw InputError(what + ": the scope tip " + show(tip) + " mm lies outside the volume (" + show(a.cwiseMin(b)) +
+                   " to " + show(a.cwiseMax(b)) + " mm); the laparoscope renders from inside");
+}
+
+nlohmann::json pose_json(const ViewCamera& c) {
+  return {{"tip_mm", vec_json(c.position_mm)}, {"forward", vec_json(c.forward)}, {"up", vec_json(c.up)},
+          {"lens", enum_name(c.lens)},         {"fov_deg", c.fov_deg}};
+}
+
+bool ffmpeg_available() { return std::system("command -v ffmpeg >/dev/null 2>&1") == 0; }
+
+// frames → <dir>.mp4 (H.264, 25 frames/s); written beside and renamed, so it is atomic too.
+bool encode_mp4(const fs::path& frame_dir, const fs::path& mp4) {
+  const fs::path tmp = mp4.string() + ".part.mp4";
+  const std::string cmd = "ffmpeg -y -loglevel error -framerate 25 -i '" + (frame_dir / "frame_%04d.png").string() +
+                          "' -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -c:v libx264 -pix_fmt yuv420p '" + tmp.string() +
+                          "' </dev/null";
+  if (std::system(cmd.c_str()) != 0) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    log::warn("ffmpeg could not encode " + mp4.string() + "; the frames are kept as PNGs");
+    return false;
+  }
+  fs::rename(tmp, mp4);
+  return true;
+}
+
+}  // namespace
+
+RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  const SceneRender& r = scene.render;
+  RenderRun run;
+  const fs::path out(opt.out_dir);
+  const fs::path deformed_ct = out / "deformed_ct.nii.gz", deformed_labels = out / "deformed_labels.nii.gz";
+  if (fs::exists(deformed_ct)) {
+    run.deformed = true;
+    run.ct_path = deformed_ct.string();
+    if (fs::exists(deformed_labels)) run.labels_path = deformed_labels.string();
+    if (!opt.map_point)
+      log::warn("rendering the deformed CT without the warp's point mapping: port skin points and target_mm are "
+                "used as given");
+  } else {
+    run.ct_path = scene.require_ct();
+    run.labels_path = scene.inputs.labels;
+  }
+  const PointMap map = opt.map_point ? opt.map_point : identity_point_map();
+  scene_transfer_function(r);  // a bad custom transfer function is reported before the CT is read
+
+  log::info("render: " + run.ct_path + (run.labels_path.empty() ? "" : " with labels " + run.labels_path));
+  const Volume ct = read_volume(run.ct_path);
+  std::unique_ptr<Volume> labels;
+  if (!run.labels_path.empty()) labels = std::make_unique<Volume>(read_volume(run.labels_path));
+  const RenderVolume volume = RenderVolume::from(ct, labels.get());
+  const RenderSettings s = settings_from_scene(r, volume.geometry);
+
+  // Poses first: every bad one is reported before any rendering.
+  struct View { std::string name; ViewCamera camera; };
+  std::vector<View> views;
+  for (const Camera& c : r.cameras) {
+    const ViewCamera cam = make_view_camera(look_at_pose(c.position_mm, c.look_at_mm, c.optics.up), c.optics, r.width,
+                                            r.height);
+    require_inside(volume, cam.position_mm, "camera '" + c.name + "'");
+    views.push_back({c.name, cam});
+  }
+  for (const Port& p : r.ports) {
+    // target_mm is planned on the original CT like the skin point, so it travels with the tissue;
+    // a label's centroid is taken where the labels are (deformed when the warp left them).
+    Vec3 target;
+    if (p.target_mm) {
+      target = map(*p.target_mm);
+    } else if (run.deformed && labels) {
+      target = label_centroid_mm(volume, *p.target_label);
+    } else if (run.deformed) {
+      throw InputError("port '" + p.name + "': target_label needs the deformed label map " +
+                       deformed_labels.string() + ", which is missing");
+    } else {
+      target = map(label_centroid_mm(volume, *p.target_label));
+    }
+    const ScopePose pose = port_pose(p.skin_point_mm, target, p.insertion_mm, map, p.optics.up);
+    const ViewCamera cam = make_view_camera(pose, p.optics, r.width, r.height);
+    require_inside(volume, cam.position_mm, "port '" + p.name + "'");
+    views.push_back({p.name, cam});
+  }
+  struct Path { std::string name; std::vector<ViewCamera> cameras; };
+  std::vector<Path> paths;
+  for (const CameraPath& p : r.paths) {
+    for (std::size_t k = 0; k < p.keyframes.size(); ++k)
+      require_inside(volume, p.keyframes[k].position_mm, "path '" + p.name + "' keyframe " + std::to_string(k));
+    Path path{p.name, {}};
+    for (const ScopePose& pose : interpolate_path(p.keyframes, p.frames, p.optics.up))
+      path.cameras.push_back(make_view_camera(pose, p.optics, r.width, r.height));
+    paths.push_back(std::move(path));
+  }
+
+  const int exterior = r.exterior_views ? 2 : 0;
+  int64_t total = int64_t(views.size()) + exterior;
+  for (const Path& p : paths) total += int64_t(p.cameras.size());
+  if (total == 0) throw InputError("the scene's render section has no cameras, ports, paths or exterior views");
+
+  fs::create_directories(out / "views");
+  Renderer renderer(opt);
+  renderer.set_volume(volume);
+  nlohmann::json view_report = nlohmann::json::array();
+  Progress progress("render", total);
+  int64_t done = 0;
+  auto tick = [&](const std::string& what) { progress.update(++done, what); };
+
+  for (const View& v : views) {
+    const RenderImage im = renderer.render(v.camera, s);
+    const std::string rel = "views/" + v.name + ".png";
+    write_view_png((out / rel).string(), im);
+    run.files.push_back(rel);
+    if (scene.output.write_depth) {
+      const std::string drel = "views/" + v.name + "_depth.png";
+      write_depth_png((out / drel).string(), im);
+      run.files.push_back(drel);
+    }
+    nlohmann::json j = pose_json(v.camera);
+    j["name"] = v.name;
+    j["file"] = rel;
+    view_report.push_back(j);
+    ++run.views;
+    tick(v.name);
+  }
+
+  nlohmann::json path_report = nlohmann::json::array();
+  const bool mp4 = !paths.empty() && ffmpeg_available();
+  for (const Path& p : paths) {
+    const fs::path dir = out / "flythrough" / p.name;
+    fs::create_directories(dir);
+    for (std::size_t f = 0; f < p.cameras.size(); ++f) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%04zu.png", f + 1);
+      write_view_png((dir / name).string(), renderer.render(p.cameras[f], s));
+      run.files.push_back("flythrough/" + p.name + "/" + name);
+      ++run.frames;
+      tick(p.name + " " + std::to_string(f + 1) + "/" + std::to_string(p.cameras.size()));
+    }
+    nlohmann::json j = {{"name", p.name}, {"frames", p.cameras.size()}, {"folder", "flythrough/" + p.name}};
+    if (mp4 && encode_mp4(dir, out / "flythrough" / (p.name + ".mp4"))) {
+      run.files.push_back("flythrough/" + p.name + ".mp4");
+      j["mp4"] = "flythrough/" + p.name + ".mp4";
+    }
+    path_report.push_back(j);
+  }
+  if (!paths.empty() && !mp4) log::info("render: ffmpeg not found; fly-throughs are PNG frames only");
+
+  if (exterior) {
+    // The abdomen from outside with CT-Air: air connected to the grid's faces is hidden, so what
+    // shows is the gas inside the body (the insufflated cavity, bowel gas, lungs) as a surface.
+    RenderVolume ext = volume;
+    ext.mark_exterior_air();
+    renderer.set_volume(ext);
+    RenderSettings es = s;
+    es.tf = preset_transfer_function(RenderPreset::CtAir);
+    es.hide_exterior_air = true;
+    es.show_labels = false;
+    const Geometry& g = volume.geometry;
+    const Vec3 c = g.to_world(0.5 * Vec3(double(g.dims[0] - 1), double(g.dims[1] - 1), double(g.dims[2] - 1)));
+    const double radius = 0.5 * (g.to_world(Vec3::Zero()) -
+                                 g.to_world(Vec3(double(g.dims[0] - 1), double(g.dims[1] - 1), double(g.dims[2] - 1))))
+                                    .norm();
+    Optics o;
+    o.fov_deg = 40.0;
+    const double dist = radius / std::sin(o.fov_deg * 3.14159265358979323846 / 360.0);
+    o.near_mm = dist - radius;
+    es.light_falloff_mm = dist;  // the headlight as bright at the body as inside the cavity
+    const std::pair<const char*, Vec3> sides[] = {{"exterior_anterior", Vec3(0, 1, 0)}, {"exterior_left", Vec3(-1, 0, 0)}};
+    for (const auto& [name, side] : sides) {
+      const ViewCamera cam =
+          make_view_camera(look_at_pose(c + dist * side, c, Vec3(0, 0, 1)), o, r.width, r.height);
+      const std::string rel = std::string("views/") + name + ".png";
+      write_view_png((out / rel).string(), renderer.render(cam, es));
+      run.files.push_back(rel);
+      nlohmann::json j = pose_json(cam);
+      j["name"] = name;
+      j["file"] = rel;
+      j["preset"] = "ct-air";
+      view_report.push_back(j);
+      ++run.views;
+      tick(name);
+    }
+  }
+  progress.finish(std::to_string(run.views) + " views, " + std::to_string(run.frames) + " frames");
+
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run.report = {{"ct", run.ct_path},
+                {"labels", run.labels_path},
+                {"deformed", run.deformed},
+                {"point_mapping", opt.map_point ? "warp" : "identity"},
+                {"transfer_function", s.tf.name},
+                {"step_mm", s.step_mm},
+                {"image", {r.width, r.height}},
+                {"render", renderer.describe()},
+                {"views", view_report},
+                {"paths", path_report},
+                {"files", run.files},
+                {"seconds", seconds},
+                {"scene", scene.echo()}};
+  write_text_file_atomic((out / "render.json").string(), run.report.dump(2) + "\n");
+  return run;
+}
+
+}  // namespace pneumo

@@ -1,0 +1,44 @@
+#pragma once
+// `pneumo render`: every camera, port and path of a scene's render section, plus exterior views,
+// rendered from the deformed CT a warp left in the output folder (else from the original CT).
+//
+// Inputs: the scene; the output folder (it may already hold deformed_ct.nii.gz and
+// deformed_labels.nii.gz); how to map original-CT points into the deformed CT (the warp's
+// point mapping; identity when absent) for the ports' skin points and point targets.
+// Outputs under out_dir (each file atomic):
+//   views/<name>.png                 cameras and ports (and <name>_depth.png with output.write_depth:
+//                                    16-bit, 0.1 mm per unit, 0 = no surface)
+//   views/exterior_anterior.png, views/exterior_left.png   (render.exterior_views)
+//   flythrough/<path>/frame_0001.png ...  and flythrough/<path>.mp4 when ffmpeg is on PATH
+//   render.json                      volume used, GL back end/version/renderer, poses, files
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "render/gl_context.h"
+#include "render/poses.h"
+#include "scene/scene.h"
+
+namespace pneumo {
+
+struct RenderOptions {
+  std::string out_dir;
+  GlBackend backend = GlBackend::Auto;
+  bool cpu_reference = false;   // render with the CPU reference instead of OpenGL (slow; checks)
+  PointMap map_point;           // original CT mm → deformed mm; empty = identity
+};
+
+struct RenderRun {
+  std::string ct_path, labels_path;  // what was rendered
+  bool deformed = false;             // from the warp's output
+  int views = 0, frames = 0;
+  std::vector<std::string> files;    // relative to out_dir
+  nlohmann::json report;             // what render.json holds
+};
+
+/// Renders everything; InputError for bad input (no CT, a tip outside the volume, an unknown
+/// target label, ...). Shows Progress over the frames.
+RenderRun render_scene(const Scene& scene, const RenderOptions& options);
+
+}  // namespace pneumo

@@ -1,0 +1,256 @@
+#include "render/ray_cast_gl.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "render/gl_api.h"
+#include "render/shader_program.h"
+
+namespace pneumo {
+namespace {
+
+GLuint make_texture(GLenum target, GLint filter) {
+  const gl::Api& g = gl::api();
+  GLuint t = 0;
+  g.GenTextures(1, &t);
+  g.BindTexture(target, t);
+  // Every texture sets its min filter: the default wants mipmaps, and without them it is incomplete.
+  g.TexParameteri(target, GL_TEXTURE_MIN_FILTER, filter);
+  g.TexParameteri(target, GL_TEXTURE_MAG_FILTER, filter);
+  g.TexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  g.TexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  if (target == GL_TEXTURE_3D) g.TexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  return t;
+}
+
+// A key for what the occupancy grid depends on besides the volume.
+std::string occupancy_key(const RenderSettings& s) {
+  std::string k = s.hide_exterior_air ? "x" : "-";
+  for (const auto& p : s.tf.opacity) k += std::to_string(p[0]) + ":" + std::to_string(p[1]) + ";";
+  return k;
+}
+
+}  // namespace
+
+struct GlRayCaster::Impl {
+  GlContext& ctx;
+  gl::ShaderProgram program;
+  GLuint vao = 0, fbo = 0, colour_tex = 0, depth_tex = 0;
+  GLuint hu_tex = 0, label_tex = 0, occ_tex = 0, tf_tex = 0, label_rgba_tex = 0;
+  int fb_width = 0, fb_height = 0;
+  bool have_volume = false;
+  Geometry geometry;
+  Mat3 w2i = Mat3::Identity();
+  float hu_scale = 1.0f;
+  std::string hu_format = "none";
+  BlockRanges ranges;
+  std::string occ_key;
+
+  explicit Impl(GlContext& c) : ctx((c.make_current(), c)), program("fullscreen.vert", "raycast.frag") {
+    const gl::Api& g = gl::api();
+    g.GenVertexArrays(1, &vao);
+    g.GenFramebuffers(1, &fbo);
+    gl::check_error("GL ray caster setup");
+  }
+
+  ~Impl() {
+    const gl::Api& g = gl::api();
+    GLuint tex[] = {colour_tex, depth_tex, hu_tex, label_tex, occ_tex, tf_tex, label_rgba_tex};
+    for (GLuint t : tex)
+      if (t) g.DeleteTextures(1, &t);
+    if (fbo) g.DeleteFramebuffers(1, &fbo);
+    if (vao) g.DeleteVertexArrays(1, &vao);
+  }
+
+  void ensure_framebuffer(int w, int h) {
+    const gl::Api& g = gl::api();
+    if (w == fb_width && h == fb_height) return;
+    if (colour_tex) g.DeleteTextures(1, &colour_tex);
+    if (depth_tex) g.DeleteTextures(1, &depth_tex);
+    colour_tex = make_texture(GL_TEXTURE_2D, GL_NEAREST);
+    g.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, nullptr);
+    depth_tex = make_texture(GL_TEXTURE_2D, GL_NEAREST);
+    g.TexImage2D(GL_TEXTURE_2D, 0, GL_R32F, w, h, 0, GL_RED, GL_FLOAT, nullptr);
+    g.BindFramebuffer(GL_FRAMEBUFFER, fbo);
+    g.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colour_tex, 0);
+    g.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, depth_tex, 0);
+    const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    g.DrawBuffers(2, bufs);
+    const GLenum status = g.CheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE)
+      throw std::runtime_error("the ray caster's framebuffer is incomplete (status " + std::to_string(status) + ")");
+    gl::check_error("framebuffer " + std::to_string(w) + "x" + std::to_string(h));
+    fb_width = w;
+    fb_height = h;
+  }
+
+  void upload_occupancy(const RenderSettings& s) {
+    const std::string key = occupancy_key(s);
+    if (key == occ_key) return;
+    const OccupancyGrid occ = occupancy(ranges, s.tf, s.hide_exterior_air);
+    const gl::Api& g = gl::api();
+    if (occ_tex) g.DeleteTextures(1, &occ_tex);
+    occ_tex = make_texture(GL_TEXTURE_3D, GL_NEAREST);
+    g.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    g.TexImage3D(GL_TEXTURE_3D, 0, GL_R8UI, GLsizei(occ.blocks[0]), GLsizei(occ.blocks[1]), GLsizei(occ.blocks[2]), 0,
+                 GL_RED_INTEGER, GL_UNSIGNED_BYTE, occ.occupied.data());
+    gl::check_error("occupancy upload");
+    occ_key = key;
+  }
+};
+
+GlRayCaster::GlRayCaster(GlContext& context) : impl_(std::make_unique<Impl>(context)) {}
+GlRayCaster::~GlRayCaster() = default;
+
+const std::string& GlRayCaster::hu_format() const { return impl_->hu_format; }
+
+void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
+  Impl& m = *impl_;
+  m.ctx.make_current();
+  const gl::Api& g = gl::api();
+  const auto& d = v.geometry.dims;
+  const int max3d = m.ctx.info().max_3d_texture_size;
+  for (int a = 0; a < 3; ++a)
+    if (d[a] > max3d)
+      throw InputError("the volume's " + std::to_string(d[a]) + " voxels along axis " + std::to_string(a) +
+                       " exceed this OpenGL's 3-D texture limit of " + std::to_string(max3d));
+  g.PixelStorei(GL_UNPACK_ALIGNMENT, 1);  // R16 rows need not be 4-byte aligned
+  if (m.hu_tex) g.DeleteTextures(1, &m.hu_tex);
+  m.hu_tex = make_texture(GL_TEXTURE_3D, GL_LINEAR);
+  if (v.hu_is_int16 && !force_float) {
+    std::vector<int16_t> h(v.hu.size());
+    for (std::size_t n = 0; n < h.size(); ++n) h[n] = static_cast<int16_t>(v.hu[n]);
+    // SNORM maps s to s/32767 exactly for s in ±32767 and filters in floating point.
+    g.TexImage3D(GL_TEXTURE_3D, 0, GL_R16_SNORM, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RED, GL_SHORT,
+                 h.data());
+    m.hu_scale = 32767.0f;
+    m.hu_format = "r16_snorm";
+  } else {
+    g.TexImage3D(GL_TEXTURE_3D, 0, GL_R32F, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RED, GL_FLOAT,
+                 v.hu.data());
+    m.hu_scale = 1.0f;
+    m.hu_format = "r32f";
+  }
+  gl::check_error("CT upload");
+  if (m.label_tex) g.DeleteTextures(1, &m.label_tex);
+  m.label_tex = make_texture(GL_TEXTURE_3D, GL_NEAREST);
+  if (!v.labels.empty()) {
+    g.TexImage3D(GL_TEXTURE_3D, 0, GL_R16UI, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RED_INTEGER,
+                 GL_UNSIGNED_SHORT, v.labels.data());
+  } else {
+    const uint16_t zero = 0;
+    g.TexImage3D(GL_TEXTURE_3D, 0, GL_R16UI, 1, 1, 1, 0, GL_RED_INTEGER, GL_UNSIGNED_SHORT, &zero);
+  }
+  gl::check_error("label upload");
+  m.geometry = v.geometry;
+  m.w2i = v.world_to_index();
+  m.ranges = block_ranges(v);
+  m.occ_key.clear();
+  m.have_volume = true;
+  log::debug("GL ray caster: volume " + std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" +
+             std::to_string(d[2]) + " as " + m.hu_format);
+}
+
+RenderImage GlRayCaster::render(const ViewCamera& cam, const RenderSettings& s) {
+  Impl& m = *impl_;
+  if (!m.have_volume) throw std::logic_error("GlRayCaster::render before set_volume");
+  if (!(s.step_mm > 0.0)) throw InputError("the ray step must be positive");
+  m.ctx.make_current();
+  const gl::Api& g = gl::api();
+  m.ensure_framebuffer(cam.width, cam.height);
+  m.upload_occupancy(s);
+
+  // Transfer function and label colour tables (small; uploaded every frame).
+  if (!m.tf_tex) m.tf_tex = make_texture(GL_TEXTURE_2D, GL_LINEAR);
+  g.BindTexture(GL_TEXTURE_2D, m.tf_tex);
+  const std::vector<float> tf = s.tf.table_rgba(kTfTableHuMin, kTfTableSize);
+  g.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, kTfTableSize, 1, 0, GL_RGBA, GL_FLOAT, tf.data());
+  if (!m.label_rgba_tex) m.label_rgba_tex = make_texture(GL_TEXTURE_2D, GL_NEAREST);
+  g.BindTexture(GL_TEXTURE_2D, m.label_rgba_tex);
+  g.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  g.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 256, 256, 0, GL_RGBA, GL_UNSIGNED_BYTE, s.label_colours.rgba.data());
+  gl::check_error("tables upload");
+
+  m.program.use();
+  const GLuint textures[] = {m.hu_tex, m.label_tex, m.occ_tex, m.tf_tex, m.label_rgba_tex};
+  const GLenum targets[] = {GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_2D, GL_TEXTURE_2D};
+  const char* names[] = {"u_hu", "u_labels", "u_occupancy", "u_tf", "u_label_rgba"};
+  for (int i = 0; i < 5; ++i) {
+    g.ActiveTexture(GL_TEXTURE0 + i);
+    g.BindTexture(targets[i], textures[i]);
+    g.Uniform1i(m.program.uniform(names[i]), i);
+  }
+  g.ActiveTexture(GL_TEXTURE0);
+  auto u3 = [&](const char* n, const Vec3& v) { g.Uniform3f(m.program.uniform(n), float(v.x()), float(v.y()), float(v.z())); };
+  auto u1 = [&](const char* n, double v) { g.Uniform1f(m.program.uniform(n), float(v)); };
+  auto i1 = [&](const char* n, int v) { g.Uniform1i(m.program.uniform(n), v); };
+  const auto& d = m.geometry.dims;
+  u3("u_dims", Vec3(double(d[0]), double(d[1]), double(d[2])));
+  float w2i[9];
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) w2i[3 * c + r] = float(m.w2i(r, c));  // column-major
+  g.UniformMatrix3fv(m.program.uniform("u_world_to_index"), 1, GL_FALSE, w2i);
+  u3("u_origin_mm", m.geometry.origin_mm);
+  u1("u_hu_scale", m.hu_scale);
+  u1("u_tf_hu_min", kTfTableHuMin);
+  u1("u_tf_size", kTfTableSize);
+  g.Uniform3i(m.program.uniform("u_blocks"), GLint(m.ranges.blocks[0]), GLint(m.ranges.blocks[1]),
+              GLint(m.ranges.blocks[2]));
+  u1("u_block", kOccupancyBlock);
+  u3("u_cam_pos", cam.position_mm);
+  u3("u_forward", cam.forward);
+  u3("u_right", cam.right);
+  u3("u_up", cam.up);
+  i1("u_fisheye", cam.lens == Lens::Fisheye ? 1 : 0);
+  u1("u_half_fov", cam.fov_deg * 3.14159265358979323846 / 360.0);
+  u1("u_near", cam.near_mm);
+  g.Uniform2f(m.program.uniform("u_image"), float(cam.width), float(cam.height));
+  u1("u_step", s.step_mm);
+  u1("u_opacity_exp", s.step_mm / kOpacityUnitMm);
+  i1("u_jitter", s.jitter ? 1 : 0);
+  g.Uniform1ui(m.program.uniform("u_seed"), s.jitter_seed);
+  i1("u_show_labels", s.show_labels ? 1 : 0);
+  u1("u_label_opacity", s.label_opacity);
+  i1("u_hide_exterior", s.hide_exterior_air ? 1 : 0);
+  u1("u_ambient", s.ambient);
+  u1("u_diffuse", s.diffuse);
+  u1("u_specular", s.specular);
+  u1("u_shininess", s.shininess);
+  u1("u_falloff", s.light_falloff_mm);
+  gl::check_error("uniforms");
+
+  g.BindFramebuffer(GL_FRAMEBUFFER, m.fbo);
+  g.Viewport(0, 0, cam.width, cam.height);
+  g.BindVertexArray(m.vao);  // core profile: a VAO must be bound even without attributes
+  g.DrawArrays(GL_TRIANGLES, 0, 3);
+  gl::check_error("ray casting draw");
+
+  RenderImage img;
+  img.width = cam.width;
+  img.height = cam.height;
+  const std::size_t npx = std::size_t(cam.width) * cam.height;
+  std::vector<float> rgba(npx * 4), depth(npx);
+  g.PixelStorei(GL_PACK_ALIGNMENT, 4);
+  g.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  g.ReadPixels(0, 0, cam.width, cam.height, GL_RGBA, GL_FLOAT, rgba.data());
+  g.ReadBuffer(GL_COLOR_ATTACHMENT1);
+  g.ReadPixels(0, 0, cam.width, cam.height, GL_RED, GL_FLOAT, depth.data());
+  gl::check_error("read back");
+  // GL rows come bottom-up; images here are top row first.
+  img.rgba.resize(npx * 4);
+  img.depth_mm.resize(npx);
+  for (int y = 0; y < cam.height; ++y) {
+    const std::size_t src = std::size_t(cam.height - 1 - y) * cam.width, dst = std::size_t(y) * cam.width;
+    std::copy_n(rgba.begin() + 4 * src, 4 * cam.width, img.rgba.begin() + 4 * dst);
+    for (int x = 0; x < cam.width; ++x) {
+      const float dm = depth[src + x];
+      img.depth_mm[dst + x] = dm < 0.0f ? std::numeric_limits<float>::infinity() : dm;
+    }
+  }
+  return img;
+}
+
+}  // namespace pneumo

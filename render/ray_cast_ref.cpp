@@ -1,0 +1,132 @@
+#include "render/ray_cast_ref.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pneumo {
+namespace {
+
+struct Sampler {
+  const RenderVolume& v;
+  int64_t nx, ny, nz;
+
+  explicit Sampler(const RenderVolume& vol)
+      : v(vol), nx(vol.geometry.dims[0]), ny(vol.geometry.dims[1]), nz(vol.geometry.dims[2]) {}
+
+  float at(int64_t i, int64_t j, int64_t k) const { return v.hu[i + nx * (j + ny * k)]; }
+
+  // Trilinear HU at a continuous index; positions beyond the voxel centres clamp to the edge.
+  double hu(const Vec3& p) const {
+    const double x = std::clamp(p.x(), 0.0, double(nx - 1));
+    const double y = std::clamp(p.y(), 0.0, double(ny - 1));
+    const double z = std::clamp(p.z(), 0.0, double(nz - 1));
+    const int64_t i = std::min<int64_t>(int64_t(x), nx - 1), j = std::min<int64_t>(int64_t(y), ny - 1),
+                  k = std::min<int64_t>(int64_t(z), nz - 1);
+    const int64_t i1 = std::min(i + 1, nx - 1), j1 = std::min(j + 1, ny - 1), k1 = std::min(k + 1, nz - 1);
+    const double fx = x - i, fy = y - j, fz = z - k;
+    const double c00 = at(i, j, k) * (1 - fx) + at(i1, j, k) * fx;
+    const double c10 = at(i, j1, k) * (1 - fx) + at(i1, j1, k) * fx;
+    const double c01 = at(i, j, k1) * (1 - fx) + at(i1, j, k1) * fx;
+    const double c11 = at(i, j1, k1) * (1 - fx) + at(i1, j1, k1) * fx;
+    return (c00 * (1 - fy) + c10 * fy) * (1 - fz) + (c01 * (1 - fy) + c11 * fy) * fz;
+  }
+
+  uint16_t label(const Vec3& p) const {
+    if (v.labels.empty()) return 0;
+    const int64_t i = std::clamp<int64_t>(int64_t(std::floor(p.x() + 0.5)), 0, nx - 1);
+    const int64_t j = std::clamp<int64_t>(int64_t(std::floor(p.y() + 0.5)), 0, ny - 1);
+    const int64_t k = std::clamp<int64_t>(int64_t(std::floor(p.z() + 0.5)), 0, nz - 1);
+    return v.labels[i + nx * (j + ny * k)];
+  }
+};
+
+// [t0, t1] where origin + t·dir (index space) lies within [0, d−1] on every axis; empty if t0 > t1.
+std::pair<double, double> clip_to_box(const Vec3& o, const Vec3& d, const Index3& dims) {
+  double t0 = -std::numeric_limits<double>::infinity(), t1 = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    const double hi = double(dims[a] - 1);
+    if (std::abs(d[a]) < 1e-12) {
+      if (o[a] < 0.0 || o[a] > hi) return {1.0, 0.0};
+      continue;
+    }
+    double ta = (0.0 - o[a]) / d[a], tb = (hi - o[a]) / d[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return {t0, t1};
+}
+
+}  // namespace
+
+RenderImage render_reference(const RenderVolume& volume, const ViewCamera& cam, const RenderSettings& s) {
+  RenderImage img;
+  img.width = cam.width;
+  img.height = cam.height;
+  img.rgba.assign(std::size_t(cam.width) * cam.height * 4, 0.0f);
+  img.depth_mm.assign(std::size_t(cam.width) * cam.height, std::numeric_limits<float>::infinity());
+  const Sampler smp(volume);
+  const Mat3 w2i = volume.world_to_index();
+  const Mat3 w2i_t = w2i.transpose();
+  const Vec3 origin_idx = w2i * (cam.position_mm - volume.geometry.origin_mm);
+  const double exponent = s.step_mm / kOpacityUnitMm;
+
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int py = 0; py < cam.height; ++py) {
+    for (int px = 0; px < cam.width; ++px) {
+      const auto dir = cam.ray(px + 0.5, py + 0.5);
+      if (!dir) continue;
+      const Vec3 didx = w2i * *dir;  // index units per mm along the ray
+      const auto [ta, tb] = clip_to_box(origin_idx, didx, volume.geometry.dims);
+      const double t_lo = std::max(ta, cam.near_mm);
+      if (!(t_lo <= tb)) continue;
+      const double j = s.jitter ? jitter_offset(px, py, s.jitter_seed) : 0.0;
+      int64_t k = std::max<int64_t>(0, int64_t(std::ceil((t_lo - cam.near_mm) / s.step_mm - j)));
+      Vec3 C = Vec3::Zero();
+      double A = 0.0;
+      double depth = std::numeric_limits<double>::infinity();
+      for (;; ++k) {
+        const double t = cam.near_mm + (double(k) + j) * s.step_mm;
+        if (t > tb) break;
+        if (t < t_lo) continue;
+        const Vec3 p = origin_idx + t * didx;
+        const uint16_t id = smp.label(p);
+        if (s.hide_exterior_air && id == kExteriorAirLabel) continue;
+        const double h = smp.hu(p);
+        const double alpha = s.tf.opacity_at(h);
+        if (alpha <= 0.0) continue;
+        const double a = 1.0 - std::pow(1.0 - std::min(alpha, 1.0), exponent);
+        Vec3 c = s.tf.colour_at(h);
+        if (s.show_labels) {
+          const auto& lc = s.label_colours.rgba[id];
+          const double w = s.label_opacity * lc[3] / 255.0;
+          c = (1.0 - w) * c + w * Vec3(lc[0], lc[1], lc[2]) / 255.0;
+        }
+        const Vec3 g_idx(0.5 * (smp.hu(p + Vec3(1, 0, 0)) - smp.hu(p - Vec3(1, 0, 0))),
+                         0.5 * (smp.hu(p + Vec3(0, 1, 0)) - smp.hu(p - Vec3(0, 1, 0))),
+                         0.5 * (smp.hu(p + Vec3(0, 0, 1)) - smp.hu(p - Vec3(0, 0, 1))));
+        const Vec3 g = w2i_t * g_idx;
+        double diffuse = 1.0, specular = 0.0;
+        if (g.norm() >= kFlatGradient) {
+          const double ndl = std::abs(g.normalized().dot(*dir));
+          diffuse = ndl;
+          specular = std::pow(ndl, s.shininess);
+        }
+        const double att = 1.0 / (1.0 + (t / s.light_falloff_mm) * (t / s.light_falloff_mm));
+        const Vec3 shaded = c * (s.ambient + s.diffuse * diffuse * att) + Vec3::Constant(s.specular * specular * att);
+        C += (1.0 - A) * a * shaded;
+        A += (1.0 - A) * a;
+        if (A >= kDepthOpacity && !std::isfinite(depth)) depth = t;
+        if (A > kEarlyTermination) break;
+      }
+      const std::size_t n = std::size_t(py) * cam.width + px;
+      for (int c = 0; c < 3; ++c) img.rgba[4 * n + c] = float(std::clamp(C[c], 0.0, 1.0));
+      img.rgba[4 * n + 3] = float(A);
+      img.depth_mm[n] = float(depth);
+    }
+  }
+  return img;
+}
+
+}  // namespace pneumo

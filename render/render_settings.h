@@ -1,0 +1,70 @@
+#pragma once
+// The ray-casting model both ray casters implement (the GLSL one in shaders/raycast.frag and the
+// CPU reference in ray_cast_ref.cpp), stated once (method.md §8):
+//
+// 1. Ray: from the camera's tip along ViewCamera::ray() of the pixel centre. It is clipped to the
+//    box of voxel centres (index space [0, dims−1]); samples sit at t_k = near + (k + j)·Δs mm for
+//    the k with t_k inside the clipped interval; j = 0, or with jitter a per-pixel hash in [0, 1)
+//    (jitter_offset(), the same bits on both sides, so jittered images still compare).
+// 2. Sample: HU by trilinear interpolation; colour c and opacity α from the transfer function;
+//    opacity corrected for the step: α′ = 1 − (1 − α)^(Δs / 1 mm). With hide_exterior_air, a
+//    sample whose nearest voxel is labelled kExteriorAirLabel contributes nothing (exterior views).
+// 3. Labels: the nearest voxel's id picks an RGBA colour; c ← mix(c, label rgb, label_opacity·a).
+// 4. Shading (Phong with a headlight at the tip): gradient g by central differences of the
+//    trilinear HU one voxel either side along each index axis, taken to world (g_w = M⁻ᵀ g with
+//    M = direction·spacing); n = g_w/|g_w|; light and view both along −dir, so
+//    diffuse = |n·dir|, specular = |n·dir|^shininess (two-sided). Headlight attenuation at the
+//    sample's distance t: a = 1/(1 + (t/d0)²). Shaded colour = c·(ambient + diffuse_k·diffuse·a)
+//    + specular_k·specular·a (white highlights). Where |g_w| < 1e-3 HU/mm (no surface), diffuse = 1
+//    and specular = 0.
+// 5. Front to back: C += (1 − A)·α′·shaded, A += (1 − A)·α′; stop once A > 0.99 (early termination).
+//    Depth: the first t at which A ≥ 0.5 (the first surface); none when A stays below.
+// 6. Output: C clamped to [0, 1] over a black background (premultiplied), A, depth in mm.
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "render/render_volume.h"
+#include "render/transfer_function.h"
+
+namespace pneumo {
+
+struct RenderSettings {
+  TransferFunction tf;
+  double step_mm = 0.5;
+  bool jitter = false;
+  uint32_t jitter_seed = 0;
+  bool show_labels = true;
+  double label_opacity = 0.5;
+  LabelColours label_colours = default_label_colours();
+  bool hide_exterior_air = false;
+  double ambient = 0.15, diffuse = 0.85, specular = 0.25, shininess = 12.0;
+  double light_falloff_mm = 100.0;
+};
+
+inline constexpr double kOpacityUnitMm = 1.0;       // Δs_ref of the opacity correction
+inline constexpr double kEarlyTermination = 0.99;   // stop compositing once A exceeds this
+inline constexpr double kDepthOpacity = 0.5;        // "first surface": A reaches this
+inline constexpr double kFlatGradient = 1e-3;       // HU/mm below which a sample has no normal
+
+/// Per-pixel start offset in [0, 1) for jitter: an integer hash of (px, py, seed); the GLSL copy
+/// in shaders/raycast.frag uses the same operations on 32-bit unsigned integers.
+inline double jitter_offset(uint32_t px, uint32_t py, uint32_t seed) {
+  uint32_t h = px * 73856093u ^ py * 19349663u ^ seed * 83492791u;
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return static_cast<double>(h >> 8) * (1.0 / 16777216.0);
+}
+
+/// A rendered view: colour (premultiplied over black) and opacity per pixel, top row first, and
+/// the depth of the first surface in mm (infinity where there is none).
+struct RenderImage {
+  int width = 0, height = 0;
+  std::vector<float> rgba;      // 4 per pixel
+  std::vector<float> depth_mm;  // 1 per pixel
+};
+
+}  // namespace pneumo

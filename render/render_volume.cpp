@@ -1,0 +1,135 @@
+#include "render/render_volume.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+#include "core/error.h"
+#include "render/transfer_function.h"
+
+namespace pneumo {
+
+RenderVolume RenderVolume::from(const Volume& ct, const Volume* labels) {
+  RenderVolume v;
+  v.geometry = ct.geometry();
+  v.hu = ct.to_float32();
+  v.hu_is_int16 = std::all_of(v.hu.begin(), v.hu.end(), [](float x) {
+    return x >= -32767.0f && x <= 32767.0f && x == std::nearbyint(x);
+  });
+  if (labels) {
+    if (!labels->geometry().same_grid(ct.geometry(), 1e-3))
+      throw InputError("the label map's voxel grid differs from the CT's; the renderer needs them on one grid");
+    v.labels.resize(ct.voxel_count());
+    for (int64_t n = 0; n < ct.voxel_count(); ++n) {
+      const double id = labels->value(n);
+      if (!(id >= 0 && id < kExteriorAirLabel) || id != std::floor(id))
+        throw InputError("label map value " + std::to_string(id) + " is not an id from 0 to 65534");
+      v.labels[n] = static_cast<uint16_t>(id);
+    }
+  }
+  return v;
+}
+
+void RenderVolume::mark_exterior_air(double threshold_hu) {
+  const auto& d = geometry.dims;
+  if (labels.empty()) labels.assign(hu.size(), 0);
+  std::vector<uint8_t> seen(hu.size(), 0);
+  std::deque<int64_t> queue;
+  auto push = [&](int64_t i, int64_t j, int64_t k) {
+    const int64_t n = geometry.linear_index(i, j, k);
+    if (seen[n] || !(hu[n] <= threshold_hu)) return;
+    seen[n] = 1;
+    queue.push_back(n);
+  };
+  for (int64_t k = 0; k < d[2]; ++k)
+    for (int64_t j = 0; j < d[1]; ++j)
+      for (int64_t i = 0; i < d[0]; ++i)
+        if (i == 0 || j == 0 || k == 0 || i == d[0] - 1 || j == d[1] - 1 || k == d[2] - 1) push(i, j, k);
+  while (!queue.empty()) {
+    const int64_t n = queue.front();
+    queue.pop_front();
+    labels[n] = kExteriorAirLabel;
+    const int64_t i = n % d[0], j = (n / d[0]) % d[1], k = n / (d[0] * d[1]);
+    if (i > 0) push(i - 1, j, k);
+    if (i + 1 < d[0]) push(i + 1, j, k);
+    if (j > 0) push(i, j - 1, k);
+    if (j + 1 < d[1]) push(i, j + 1, k);
+    if (k > 0) push(i, j, k - 1);
+    if (k + 1 < d[2]) push(i, j, k + 1);
+  }
+}
+
+Mat3 RenderVolume::world_to_index() const {
+  return (geometry.direction * geometry.spacing_mm.asDiagonal()).inverse();
+}
+
+bool RenderVolume::contains(const Vec3& world_mm) const {
+  const Vec3 idx = world_to_index() * (world_mm - geometry.origin_mm);
+  for (int a = 0; a < 3; ++a)
+    if (!(idx[a] >= 0.0 && idx[a] <= static_cast<double>(geometry.dims[a] - 1))) return false;
+  return true;
+}
+
+LabelColours default_label_colours() {
+  LabelColours c;
+  auto set = [&](std::initializer_list<int> ids, uint8_t r, uint8_t g, uint8_t b) {
+    for (int id : ids) c.rgba[id] = {r, g, b, 255};
+  };
+  // Kitasaka 2004 Fig. 6: liver dark red, kidneys yellow, aorta green; the rest chosen to stay
+  // apart from those and from the flesh tones of the transfer function.
+  set({5}, 110, 10, 10);           // liver
+  set({2, 3}, 235, 205, 30);       // kidneys
+  set({52, 65, 66}, 30, 170, 60);  // aorta, iliac arteries
+  set({63, 64, 67, 68}, 40, 80, 200);  // inferior vena cava, portal vein, iliac veins
+  set({1}, 150, 60, 160);          // spleen
+  set({4}, 90, 160, 40);           // gallbladder
+  set({6}, 230, 140, 150);         // stomach
+  set({7}, 240, 150, 40);          // pancreas
+  set({18, 19}, 250, 190, 170);    // small bowel, duodenum
+  set({20}, 200, 150, 110);        // colon
+  return c;
+}
+
+BlockRanges block_ranges(const RenderVolume& v) {
+  const auto& d = v.geometry.dims;
+  const int B = kOccupancyBlock;
+  BlockRanges r;
+  for (int a = 0; a < 3; ++a) r.blocks[a] = std::max<int64_t>(1, (d[a] - 1 + B - 1) / B);
+  const int64_t nb = r.blocks[0] * r.blocks[1] * r.blocks[2];
+  r.min_hu.assign(nb, 0);
+  r.max_hu.assign(nb, 0);
+  r.all_exterior.assign(nb, 0);
+  const bool has_labels = !v.labels.empty();
+#pragma omp parallel for schedule(dynamic)
+  for (int64_t b = 0; b < nb; ++b) {
+    const int64_t bx = b % r.blocks[0], by = (b / r.blocks[0]) % r.blocks[1], bz = b / (r.blocks[0] * r.blocks[1]);
+    float lo = INFINITY, hi = -INFINITY;
+    bool exterior = has_labels;
+    // Voxel centres [b·B, (b+1)·B] inclusive, clipped to the grid.
+    for (int64_t k = bz * B; k <= std::min<int64_t>((bz + 1) * B, d[2] - 1); ++k)
+      for (int64_t j = by * B; j <= std::min<int64_t>((by + 1) * B, d[1] - 1); ++j)
+        for (int64_t i = bx * B; i <= std::min<int64_t>((bx + 1) * B, d[0] - 1); ++i) {
+          const int64_t n = v.geometry.linear_index(i, j, k);
+          lo = std::min(lo, v.hu[n]);
+          hi = std::max(hi, v.hu[n]);
+          if (has_labels && v.labels[n] != kExteriorAirLabel) exterior = false;
+        }
+    r.min_hu[b] = lo;
+    r.max_hu[b] = hi;
+    r.all_exterior[b] = exterior ? 1 : 0;
+  }
+  return r;
+}
+
+OccupancyGrid occupancy(const BlockRanges& r, const TransferFunction& tf, bool hide_exterior) {
+  OccupancyGrid g;
+  g.blocks = r.blocks;
+  g.occupied.resize(r.min_hu.size());
+  for (std::size_t b = 0; b < r.min_hu.size(); ++b) {
+    const bool empty = tf.max_opacity(r.min_hu[b], r.max_hu[b]) <= 0.0 || (hide_exterior && r.all_exterior[b]);
+    g.occupied[b] = empty ? 0 : 1;
+  }
+  return g;
+}
+
+}  // namespace pneumo

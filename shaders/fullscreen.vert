@@ -1,0 +1,6 @@
+// One triangle that covers the viewport; no vertex buffers (a VAO must still be bound in core).
+#version 330 core
+void main() {
+  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}

@@ -1,0 +1,141 @@
+// The laparoscope's ray caster (method.md §8): one ray per pixel from the camera model, front-to-back
+// compositing with opacity correction, early termination, empty-space skipping, Phong shading with
+// a headlight, organ labels. The model is stated in render/render_settings.h; the CPU reference
+// (render/ray_cast_ref.cpp) implements the same model and the tests compare the two.
+#version 330 core
+
+layout(location = 0) out vec4 out_colour;  // premultiplied RGB over black, accumulated opacity
+layout(location = 1) out float out_depth;  // mm to the first surface, -1 where there is none
+
+uniform sampler3D u_hu;          // HU × u_hu_scale (R16_SNORM: 1/32767; R32F: 1), linear filtering
+uniform usampler3D u_labels;     // label ids, nearest (texelFetch)
+uniform usampler3D u_occupancy;  // 1 = block may hold something visible
+uniform sampler2D u_tf;          // RGBA per HU, u_tf_size entries from u_tf_hu_min, linear
+uniform sampler2D u_label_rgba;  // 256 × 256: id = x + 256·y, RGBA8
+
+uniform vec3 u_dims;             // voxels per axis
+uniform mat3 u_world_to_index;   // (direction·spacing)⁻¹
+uniform vec3 u_origin_mm;        // world position of voxel (0,0,0)
+uniform float u_hu_scale;
+uniform float u_tf_hu_min;
+uniform float u_tf_size;
+uniform ivec3 u_blocks;
+uniform float u_block;           // voxels per occupancy block
+
+uniform vec3 u_cam_pos, u_forward, u_right, u_up;
+uniform int u_fisheye;
+uniform float u_half_fov;        // radians
+uniform float u_near;
+uniform vec2 u_image;            // width, height
+
+uniform float u_step;            // mm
+uniform float u_opacity_exp;     // Δs / 1 mm
+uniform int u_jitter;
+uniform uint u_seed;
+uniform int u_show_labels;
+uniform float u_label_opacity;
+uniform int u_hide_exterior;
+uniform float u_ambient, u_diffuse, u_specular, u_shininess, u_falloff;
+
+const uint kExteriorAir = 65535u;
+const float kEarlyTermination = 0.99;
+const float kDepthOpacity = 0.5;
+const float kFlatGradient = 1e-3;
+
+float hu_at(vec3 idx) { return texture(u_hu, (idx + 0.5) / u_dims).r * u_hu_scale; }
+
+uint label_at(vec3 idx) {
+  ivec3 v = clamp(ivec3(floor(idx + 0.5)), ivec3(0), ivec3(u_dims) - 1);
+  return texelFetch(u_labels, v, 0).r;
+}
+
+float jitter_offset(uint px, uint py, uint seed) {
+  uint h = (px * 73856093u) ^ (py * 19349663u) ^ (seed * 83492791u);
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return float(h >> 8) * (1.0 / 16777216.0);
+}
+
+// Ray parameter interval inside the axis-aligned box [lo, hi] (index space); t0 > t1 when missed.
+vec2 clip_box(vec3 o, vec3 d, vec3 lo, vec3 hi) {
+  vec3 inv = 1.0 / mix(d, vec3(1e-20), equal(d, vec3(0.0)));
+  vec3 ta = (lo - o) * inv, tb = (hi - o) * inv;
+  vec3 tmin = min(ta, tb), tmax = max(ta, tb);
+  return vec2(max(max(tmin.x, tmin.y), tmin.z), min(min(tmax.x, tmax.y), tmax.z));
+}
+
+void main() {
+  out_colour = vec4(0.0);
+  out_depth = -1.0;
+  // Pixel centre with the top row first, as the CPU reference counts them.
+  vec2 pix = vec2(gl_FragCoord.x, u_image.y - gl_FragCoord.y);
+  float x = 2.0 * pix.x / u_image.x - 1.0;
+  float y = (1.0 - 2.0 * pix.y / u_image.y) * u_image.y / u_image.x;
+  vec3 dir;
+  if (u_fisheye == 0) {
+    dir = normalize(u_forward + tan(u_half_fov) * (x * u_right + y * u_up));
+  } else {
+    float r = sqrt(x * x + y * y);
+    if (r > 1.0) return;  // outside the image circle
+    float theta = r * u_half_fov;
+    dir = r > 0.0 ? normalize(cos(theta) * u_forward + sin(theta) / r * (x * u_right + y * u_up)) : u_forward;
+  }
+
+  vec3 o = u_world_to_index * (u_cam_pos - u_origin_mm);
+  vec3 d = u_world_to_index * dir;  // index units per mm
+  vec2 tc = clip_box(o, d, vec3(0.0), u_dims - 1.0);
+  float t_lo = max(tc.x, u_near), t_hi = tc.y;
+  if (!(t_lo <= t_hi)) return;
+  float j = u_jitter != 0 ? jitter_offset(uint(pix.x), uint(pix.y), u_seed) : 0.0;
+  int k = max(0, int(ceil((t_lo - u_near) / u_step - j)));
+
+  mat3 index_to_world_t = transpose(u_world_to_index);
+  vec3 C = vec3(0.0);
+  float A = 0.0;
+  for (;; ++k) {
+    float t = u_near + (float(k) + j) * u_step;
+    if (t > t_hi) break;
+    if (t < t_lo) continue;
+    vec3 p = o + t * d;
+    // Empty-space skipping: jump to the first sample at or beyond this block's far face.
+    ivec3 b = clamp(ivec3(floor(p / u_block)), ivec3(0), u_blocks - 1);
+    if (texelFetch(u_occupancy, b, 0).r == 0u) {
+      vec3 lo = vec3(b) * u_block;
+      float t_exit = clip_box(o, d, lo, lo + u_block).y;
+      k = max(k, int(ceil((t_exit - u_near) / u_step - j)) - 1);  // the loop's ++k lands on it
+      continue;
+    }
+    uint id = (u_show_labels != 0 || u_hide_exterior != 0) ? label_at(p) : 0u;  // a fetch saved otherwise
+    if (u_hide_exterior != 0 && id == kExteriorAir) continue;
+    float h = hu_at(p);
+    vec4 tf = texture(u_tf, vec2((h - u_tf_hu_min + 0.5) / u_tf_size, 0.5));
+    if (tf.a <= 0.0) continue;
+    float a = 1.0 - pow(1.0 - min(tf.a, 1.0), u_opacity_exp);
+    vec3 c = tf.rgb;
+    if (u_show_labels != 0) {
+      vec4 lc = texelFetch(u_label_rgba, ivec2(int(id & 255u), int(id >> 8)), 0);
+      c = mix(c, lc.rgb, u_label_opacity * lc.a);
+    }
+    vec3 g_idx = 0.5 * vec3(hu_at(p + vec3(1, 0, 0)) - hu_at(p - vec3(1, 0, 0)),
+                            hu_at(p + vec3(0, 1, 0)) - hu_at(p - vec3(0, 1, 0)),
+                            hu_at(p + vec3(0, 0, 1)) - hu_at(p - vec3(0, 0, 1)));
+    vec3 g = index_to_world_t * g_idx;
+    float diffuse = 1.0, specular = 0.0;
+    float glen = length(g);
+    if (glen >= kFlatGradient) {
+      float ndl = abs(dot(g / glen, dir));
+      diffuse = ndl;
+      specular = pow(ndl, u_shininess);
+    }
+    float att = 1.0 / (1.0 + (t / u_falloff) * (t / u_falloff));
+    vec3 shaded = c * (u_ambient + u_diffuse * diffuse * att) + vec3(u_specular * specular * att);
+    C += (1.0 - A) * a * shaded;
+    A += (1.0 - A) * a;
+    if (A >= kDepthOpacity && out_depth < 0.0) out_depth = t;
+    if (A > kEarlyTermination) break;
+  }
+  out_colour = vec4(clamp(C, 0.0, 1.0), A);
+}
