@@ -8,7 +8,7 @@
 // peer's phantom (../shared/peers/phantom.py). With PNEUMO_BENCH_VTK_DIR set, that volume and the
 // camera are also written there as phantom.mhd/.raw/.json for ../shared/peers/vtk_render.py, so
 // VTK renders the same view at the same size and sample distance.
-//   build/bench/pneumo_bench --benchmark_filter=Render --benchmark_repetitions=5 \
+//   build/bench/pneumo_bench --benchmark_filter=Render --benchmark_repetitions=5
 //       --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 

@@ -109,7 +109,9 @@ TEST_P(RenderGlVsRef, ImagesAgreeByPsnrAndAreNotBlank) {
     const ImageStats st = image_stats(*im);
     EXPECT_TRUE(st.finite);
     EXPECT_GE(st.covered_fraction, k.min_covered) << k.name;
-    if (k.min_covered > 0) EXPECT_GT(st.mean_rgb, 0.03) << k.name << ": image nearly black";
+    if (k.min_covered > 0) {
+      EXPECT_GT(st.mean_rgb, 0.03) << k.name << ": image nearly black";
+    }
   }
   // Depth maps: where both see a surface, they agree within one step (the float32 sample
   // positions can put the A ≥ 0.5 crossing one sample apart) except at a few silhouette pixels.
