@@ -4,7 +4,7 @@
 
 namespace pneumo {
 
-PointMap identity_point_map() {
+PointMapFn identity_point_map() {
   return [](const Vec3& p) { return p; };
 }
 
@@ -25,7 +25,7 @@ Vec3 label_centroid_mm(const RenderVolume& v, int label) {
   return v.geometry.to_world(sum / double(count));
 }
 
-ScopePose port_pose(const Vec3& skin_point_mm, const Vec3& target_mm, double insertion_mm, const PointMap& map,
+ScopePose port_pose(const Vec3& skin_point_mm, const Vec3& target_mm, double insertion_mm, const PointMapFn& map,
                     const Vec3& up_hint) {
   const Vec3 skin = map ? map(skin_point_mm) : skin_point_mm;
   ScopePose pose = look_at_pose(skin, target_mm, up_hint);

@@ -9,10 +9,7 @@
 
 namespace pneumo {
 
-/// Maps a point of the original CT (world mm) to where the deformation took it (world mm of the
-/// deformed CT). The warp provides it; without a deformation it is the identity.
-using PointMap = std::function<Vec3(const Vec3&)>;
-PointMap identity_point_map();
+PointMapFn identity_point_map();
 
 /// Centroid (world mm) of the voxels carrying `label`; InputError naming the label when none do
 /// or the volume has no label map.
@@ -22,6 +19,6 @@ Vec3 label_centroid_mm(const RenderVolume& volume, int label);
 /// deformed frame), the tip `insertion_mm` beyond the skin along that axis.
 /// InputError when the target coincides with the carried skin point.
 ScopePose port_pose(const Vec3& skin_point_mm, const Vec3& target_mm, double insertion_mm,
-                    const PointMap& map, const Vec3& up_hint);
+                    const PointMapFn& map, const Vec3& up_hint);
 
 }  // namespace pneumo

@@ -116,7 +116,7 @@ TEST(RenderPoses, LabelCentroidAndPortCarriedThroughTheDeformation) {
   const RenderVolume v = make_cavity_phantom(p);
   EXPECT_LT((label_centroid_mm(v, p.organ_label) - p.organ_centre_mm).norm(), 0.3);
   EXPECT_THROW(label_centroid_mm(v, 99), InputError);
-  const PointMap lift = [](const Vec3& x) { return Vec3(x + Vec3(0, 0, 12)); };
+  const PointMapFn lift = [](const Vec3& x) { return Vec3(x + Vec3(0, 0, 12)); };
   const ScopePose pose = port_pose(Vec3(0, 40, 0), Vec3(0, -35, 12), 10, lift, Vec3(0, 0, 1));
   EXPECT_LT((pose.axis - Vec3(0, -1, 0)).norm(), 1e-12);           // skin (0,40,12) → target (0,-35,12)
   EXPECT_LT((pose.tip_mm - Vec3(0, 30, 12)).norm(), 1e-12);        // 10 mm beyond the carried skin point

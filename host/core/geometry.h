@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 namespace pneumo {
@@ -11,6 +12,11 @@ using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 using Mat4 = Eigen::Matrix4d;
 using Index3 = std::array<int64_t, 3>;
+
+/// Maps a point of the original CT (world mm) to where the deformation took it (world mm of the
+/// deformed CT): the warp's point mapping (warp/point_map.h) as the renderer and the evaluation
+/// take it; without a deformation, the identity.
+using PointMapFn = std::function<Vec3(const Vec3&)>;
 
 /// World coordinates are NIfTI RAS+ millimetres: +x Right, +y Anterior, +z Superior.
 /// A voxel index (i,j,k) maps to world as  x = origin_mm + direction * diag(spacing_mm) * (i,j,k).

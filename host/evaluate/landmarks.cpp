@@ -43,7 +43,7 @@ RigidTransform horn_rigid(const std::vector<Vec3>& p, const std::vector<Vec3>& q
   return out;
 }
 
-LandmarkEvaluation evaluate_landmarks(const std::vector<Landmark>& marks, const PointMap& map) {
+LandmarkEvaluation evaluate_landmarks(const std::vector<Landmark>& marks, const PointMapFn& map) {
   LandmarkEvaluation e;
   std::vector<Vec3> before_tracker, before_ct;
   for (const Landmark& m : marks) {

@@ -23,9 +23,6 @@ struct RigidTransform {
 /// about that line is then undetermined).
 RigidTransform horn_rigid(const std::vector<Vec3>& p, const std::vector<Vec3>& q);
 
-/// Maps a point of the original CT (world mm) to where the deformation moved it.
-using PointMap = std::function<Vec3(const Vec3&)>;
-
 struct LandmarkResult {
   std::string name;
   Vec3 ct_mm, simulated_mm;                 // before (CT) and simulated after
@@ -43,7 +40,7 @@ struct LandmarkEvaluation {
                                             // horizontal (R–L), ventrodorsal (A–P), cephalocaudal (S–I)
 };
 
-LandmarkEvaluation evaluate_landmarks(const std::vector<Landmark>& marks, const PointMap& map);
+LandmarkEvaluation evaluate_landmarks(const std::vector<Landmark>& marks, const PointMapFn& map);
 nlohmann::json to_json(const LandmarkEvaluation& e);
 
 }  // namespace pneumo

@@ -121,7 +121,7 @@ RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
     run.ct_path = scene.require_ct();
     run.labels_path = scene.inputs.labels;
   }
-  const PointMap map = opt.map_point ? opt.map_point : identity_point_map();
+  const PointMapFn map = opt.map_point ? opt.map_point : identity_point_map();
   scene_transfer_function(r);  // a bad custom transfer function is reported before the CT is read
 
   log::info("render: " + run.ct_path + (run.labels_path.empty() ? "" : " with labels " + run.labels_path));

@@ -26,7 +26,7 @@ struct RenderOptions {
   std::string out_dir;
   GlBackend backend = GlBackend::Auto;
   bool cpu_reference = false;   // render with the CPU reference instead of OpenGL (slow; checks)
-  PointMap map_point;           // original CT mm → deformed mm; empty = identity
+  PointMapFn map_point;           // original CT mm → deformed mm; empty = identity
 };
 
 struct RenderRun {
