@@ -15,5 +15,6 @@ Run add_scene(CLI::App& app);
 Run add_roles(CLI::App& app);
 Run add_validate(CLI::App& app);
 Run add_simulate(CLI::App& app);
+Run add_warp(CLI::App& app);
 
 }  // namespace pneumo::cli

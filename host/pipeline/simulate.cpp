@@ -9,6 +9,7 @@
 #include "core/log.h"
 #include "core/units.h"
 #include "cl/cl_runtime.h"
+#include "mesh/deformation_file.h"
 #include "mesh/vtu_writer.h"
 #include "solve/solver_cl.h"
 
@@ -153,6 +154,13 @@ void write_simulation(const Scene& scene, const Simulation& sim, const std::stri
         << units::m_to_mm(h.max_displacement_m) << "," << units::m_to_mm(h.max_speed_m_s) << "\n";
   write_text_file_atomic(path("convergence.csv"), csv.str());
   write_text_file_atomic(path("scene_used.json"), scene.echo().dump(2) + "\n");
+  // The solved shape for `pneumo warp` and later stages (deformation_file.h).
+  Deformation def;
+  def.displacement_m.resize(sim.result.x.size());
+  for (std::size_t n = 0; n < sim.result.x.size(); ++n) def.displacement_m[n] = sim.result.x[n] - sim.mesh.rest_m[n];
+  def.pressure_pa = sim.result.final_pressure_pa;
+  def.converged = sim.result.converged;
+  write_deformation(path("deformation.bin"), sim.mesh, def);
   // metrics.json last: its presence says the run finished.
   write_text_file_atomic(path("metrics.json"), simulation_metrics(scene, sim).dump(2) + "\n");
 }

@@ -35,8 +35,9 @@ DeformationMetrics deformation_metrics(const Mesh& m, const std::vector<Vec3>& x
 /// The metrics.json of a simulation (keys listed in docs and tests).
 nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim);
 
-/// Writes mesh_initial.vtu, mesh_deformed.vtu, metrics.json, convergence.csv and scene_used.json
-/// into `dir` (created if needed), each atomically.
+/// Writes mesh_initial.vtu, mesh_deformed.vtu, convergence.csv, scene_used.json, deformation.bin
+/// (the node displacements `pneumo warp` reads) and metrics.json (last) into `dir` (created if
+/// needed), each atomically.
 void write_simulation(const Scene& scene, const Simulation& sim, const std::string& dir);
 
 }  // namespace pneumo
