@@ -8,7 +8,7 @@
 //    source point and checks the role there; it records the lowest accepting tetrahedron's index
 //    per voxel with atomic_min (T, one past the last index, marks "inside a deformed tetrahedron
 //    but accepted by none"; INT_MAX "inside none"). The lowest index wins whatever the schedule.
-//  warp_sample (one work-item per output voxel) recomputes the winner's weights and source point
+//  warp_sample (one work-item per 32 voxels of a row) recomputes the winner's weights and source point
 //    (the same arithmetic, so the same bits) and samples: CT trilinear, label nearest; or gas; or
 //    the voxel's own value.
 //
@@ -54,6 +54,27 @@ bool inside(const float3 w, const float tol) {
   return w0 >= -tol && w.x >= -tol && w.y >= -tol && w.z >= -tol;
 }
 
+// The voxels of a row worth testing: where each weight, linear along i, is ≥ −tol, widened by one
+// voxel each side so that rounding here never drops a voxel the exact test would take. Returns
+// (first, last) offsets from lo_x; first > last when empty.
+int2 row_span(__global const float4* restrict tet, const long t, const float3 p_lo, const int last, const float tol) {
+  const float3 a = weights(tet, t, p_lo);
+  const float3 b = (float3)(tet[8 * t + 1].x, tet[8 * t + 2].x, tet[8 * t + 3].x);
+  const float ac[4] = {1.0f - a.x - a.y - a.z, a.x, a.y, a.z};
+  const float bc[4] = {-b.x - b.y - b.z, b.x, b.y, b.z};
+  float t_lo = 0.0f, t_hi = (float)last;
+  for (int c = 0; c < 4; ++c) {
+    const float bound = (-tol - ac[c]) / bc[c];
+    if (bc[c] > 0.0f) t_lo = fmax(t_lo, bound);
+    else if (bc[c] < 0.0f) t_hi = fmin(t_hi, bound);
+    else if (ac[c] < -tol) t_hi = -1.0f;
+  }
+  if (!(t_lo <= t_hi + 2.0f)) return (int2)(1, 0);
+  t_lo = clamp(t_lo, 0.0f, (float)last);
+  t_hi = clamp(t_hi, 0.0f, (float)last);
+  return (int2)(max(0, (int)ceil(t_lo) - 1), min(last, (int)floor(t_hi) + 1));
+}
+
 __kernel void warp_scatter(__global const float4* restrict tet, __global const int4* restrict bbox, const int n_tets,
                            __global const uchar* restrict roles, const int4 src_dims, const int4 box_lo,
                            const int4 box_dims, const float tol, __global volatile int* owner) {
@@ -64,7 +85,8 @@ __kernel void warp_scatter(__global const float4* restrict tet, __global const i
   for (int k = lo.z; k <= hi.z; ++k)
     for (int j = lo.y; j <= hi.y; ++j) {
       const long row = (long)box_dims.x * ((long)(j - box_lo.y) + (long)box_dims.y * (long)(k - box_lo.z)) - box_lo.x;
-      for (int i = lo.x; i <= hi.x; ++i) {
+      const int2 span = row_span(tet, t, (float3)((float)lo.x, (float)j, (float)k), hi.x - lo.x, tol);
+      for (int i = lo.x + span.x; i <= lo.x + span.y; ++i) {
         const float3 p = (float3)((float)i, (float)j, (float)k);
         const float3 w = weights(tet, t, p);
         if (!inside(w, tol)) continue;
@@ -100,46 +122,55 @@ float ct_trilinear(__global const float* restrict ct, const int4 d, const float3
   return c0 * (1.0f - f.z) + c1 * f.z;
 }
 
-// Global size (box_dims.x rounded up to the local size, box_dims.y, box_dims.z).
+#define ROW_CHUNK 32
+
+// One work-item per ROW_CHUNK consecutive output voxels of a row (one per voxel would make millions
+// of tiny work-groups, whose launch costs more than their work on a CPU device). Global size: the
+// row count × ceil(box_dims.x / ROW_CHUNK), rounded up to the local size.
 __kernel void warp_sample(__global const float4* restrict tet, __global const int* restrict owner, const int n_tets,
                           __global const float* restrict ct, __global const ushort* restrict labels,
                           const int has_labels, const int4 src_dims, const int4 box_lo, const int4 box_dims,
-                          __global const uchar* restrict cube_meshed, const int4 cubes, const int cube_voxels,
-                          const float gas_hu, const ushort cavity_label, __global float* restrict out_ct,
-                          __global ushort* restrict out_labels, __global uchar* restrict out_outcome) {
-  const int x = get_global_id(0), y = get_global_id(1), z = get_global_id(2);
-  if (x >= box_dims.x) return;
-  const long n = (long)x + (long)box_dims.x * ((long)y + (long)box_dims.y * (long)z);
-  const int i = x + box_lo.x, j = y + box_lo.y, k = z + box_lo.z;
-  const int o = owner[n];
-  float hu;
-  ushort label = 0;
-  uchar outcome;
-  if (o < n_tets) {
-    const float3 p = (float3)((float)i, (float)j, (float)k);
-    const float3 src = source_point(tet, o, p, weights(tet, o, p));
-    hu = ct_trilinear(ct, src_dims, src);
-    if (has_labels) {
-      const long v = nearest_voxel(src, src_dims);
-      label = v < 0 ? (ushort)0 : labels[v];
-    }
-    outcome = OUTCOME_CARRIED;
-  } else {
-    const int a = i / cube_voxels, b = j / cube_voxels, c = k / cube_voxels;
-    const bool rest_space = a < cubes.x && b < cubes.y && c < cubes.z &&
-                            cube_meshed[(long)a + (long)cubes.x * ((long)b + (long)cubes.y * (long)c)] != 0;
-    if (o == n_tets || rest_space) {
+                          __global const uchar* restrict cube_meshed, const int4 cubes,
+                          __global const int* restrict cube_of, const float gas_hu, const ushort cavity_label,
+                          __global float* restrict out_ct, __global ushort* restrict out_labels,
+                          __global uchar* restrict out_outcome) {
+  const long gid = get_global_id(0);
+  const int chunks = (box_dims.x + ROW_CHUNK - 1) / ROW_CHUNK;
+  const long row = gid / chunks;
+  if (row >= (long)box_dims.y * (long)box_dims.z) return;
+  const int y = (int)(row % box_dims.y), z = (int)(row / box_dims.y);
+  const int x_begin = (int)(gid % chunks) * ROW_CHUNK, x_end = min(box_dims.x, x_begin + ROW_CHUNK);
+  const int j = y + box_lo.y, k = z + box_lo.z;
+  // cube_of: the lattice cube of each index, axis after axis (a table: no divisions per voxel).
+  const long cube_row = (long)cubes.x * ((long)cube_of[src_dims.x + j] + (long)cubes.y * (long)cube_of[src_dims.x + src_dims.y + k]);
+  const long src_row = (long)src_dims.x * ((long)j + (long)src_dims.y * (long)k);
+  for (int x = x_begin; x < x_end; ++x) {
+    const long n = (long)x + (long)box_dims.x * row;
+    const int i = x + box_lo.x;
+    const int o = owner[n];
+    float hu;
+    ushort label = 0;
+    uchar outcome;
+    if (o < n_tets) {
+      const float3 p = (float3)((float)i, (float)j, (float)k);
+      const float3 src = source_point(tet, o, p, weights(tet, o, p));
+      hu = ct_trilinear(ct, src_dims, src);
+      if (has_labels) {
+        const long v = nearest_voxel(src, src_dims);
+        label = v < 0 ? (ushort)0 : labels[v];
+      }
+      outcome = OUTCOME_CARRIED;
+    } else if (o == n_tets || cube_meshed[cube_row + cube_of[i]] != 0) {
       hu = gas_hu;
       label = cavity_label;
       outcome = OUTCOME_GAS;
     } else {
-      const long v = (long)i + (long)src_dims.x * ((long)j + (long)src_dims.y * (long)k);
-      hu = ct[v];
-      if (has_labels) label = labels[v];
+      hu = ct[src_row + i];
+      if (has_labels) label = labels[src_row + i];
       outcome = OUTCOME_KEPT;
     }
+    out_ct[n] = hu;
+    if (has_labels) out_labels[n] = label;
+    out_outcome[n] = outcome;
   }
-  out_ct[n] = hu;
-  if (has_labels) out_labels[n] = label;
-  out_outcome[n] = outcome;
 }

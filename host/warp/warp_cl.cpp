@@ -5,13 +5,14 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "warp/phase_timer.h"
 #include "warp/warp.h"
 
 namespace pneumo {
 
 namespace {
 
-constexpr std::size_t kLocal = 64;   // warp_sample's work-group along x (fixed: PoCL compiles per size)
+constexpr std::size_t kLocal = 64;   // both kernels' work-group (fixed: PoCL compiles per size)
 
 cl_int4 int4_of(const Index3& v) { return {{cl_int(v[0]), cl_int(v[1]), cl_int(v[2]), 0}}; }
 
@@ -87,9 +88,11 @@ WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource
   ctx.check_fits(src_bytes + out_bytes + tet_bytes,
                  std::max<uint64_t>(uint64_t(n_src) * 4, uint64_t(n_out) * 4), "the image warp");
 
+  PhaseTimer timer("warp on " + ctx.info().spec());
   WarpResult out;
   out.device = ctx.info().spec() + " " + ctx.info().name;
   const DeviceTets dt = prepare_tets(mesh, box);
+  timer.lap("prepare");
   cl::Buffer tet = upload(ctx, dt.rec.data(), dt.rec.size());
   cl::Buffer bbox = upload(ctx, dt.bbox.data(), dt.bbox.size());
   cl::Buffer ct = upload(ctx, src.ct_hu, std::size_t(n_src));
@@ -97,27 +100,38 @@ WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource
   cl::Buffer roles = upload(ctx, reinterpret_cast<const uint8_t*>(src.roles), std::size_t(n_src));
   cl::Buffer labels = upload(ctx, src.labels, has_labels ? std::size_t(n_src) : 0);
   cl::Buffer cubes = upload(ctx, mesh.cube_meshed.data(), mesh.cube_meshed.size());
+  // The cube of every working-grid index, axis after axis (every index lies in the lattice: it has
+  // ceil(dims / L) cubes per axis).
+  std::vector<cl_int> cube_of_host;
+  for (int a = 0; a < 3; ++a)
+    for (int64_t i = 0; i < mesh.grid.dims[a]; ++i) cube_of_host.push_back(cl_int(i / mesh.cube_voxels));
+  cl::Buffer cube_of = upload(ctx, cube_of_host.data(), cube_of_host.size());
   cl::Buffer owner(ctx.context(), CL_MEM_READ_WRITE, std::size_t(n_out) * sizeof(cl_int));
   ctx.queue().enqueueFillBuffer(owner, cl_int(INT_MAX), 0, std::size_t(n_out) * sizeof(cl_int));
   cl::Buffer out_ct(ctx.context(), CL_MEM_WRITE_ONLY, std::size_t(n_out) * sizeof(float));
   cl::Buffer out_labels(ctx.context(), CL_MEM_WRITE_ONLY, std::size_t(has_labels ? n_out : 1) * sizeof(uint16_t));
   cl::Buffer out_outcome(ctx.context(), CL_MEM_WRITE_ONLY, std::size_t(n_out));
 
+  ctx.queue().finish();
+  timer.lap("upload");
   const cl_int4 src_dims = int4_of(mesh.grid.dims), box_lo = int4_of(box.lo), box_dims = int4_of(box.dims);
   cl::Kernel scatter = ctx.kernel("warp.cl", "warp_scatter");
   ocl::set_args(scatter, tet, bbox, cl_int(T), roles, src_dims, box_lo, box_dims, cl_float(kWarpTolerance), owner);
   const std::size_t tet_global = (std::size_t(T) + kLocal - 1) / kLocal * kLocal;
   if (T > 0) ctx.queue().enqueueNDRangeKernel(scatter, cl::NullRange, cl::NDRange(tet_global), cl::NDRange(kLocal));
 
+  ctx.queue().finish();
+  timer.lap("scatter");
   cl::Kernel sample = ctx.kernel("warp.cl", "warp_sample");
   ocl::set_args(sample, tet, owner, cl_int(T), ct, labels, cl_int(has_labels ? 1 : 0), src_dims, box_lo, box_dims,
-                cubes, int4_of(Index3{mesh.cubes[0], mesh.cubes[1], mesh.cubes[2]}), cl_int(mesh.cube_voxels),
+                cubes, int4_of(Index3{mesh.cubes[0], mesh.cubes[1], mesh.cubes[2]}), cube_of,
                 cl_float(opt.gas_hu), cl_ushort(opt.cavity_label), out_ct, out_labels, out_outcome);
-  const std::size_t gx = (std::size_t(box.dims[0]) + kLocal - 1) / kLocal * kLocal;
-  ctx.queue().enqueueNDRangeKernel(sample, cl::NullRange,
-                                   cl::NDRange(gx, std::size_t(box.dims[1]), std::size_t(box.dims[2])),
-                                   cl::NDRange(kLocal, 1, 1));
-
+  constexpr int64_t kRowChunk = 32;   // ROW_CHUNK of kernels/warp.cl
+  const int64_t items = (box.dims[0] + kRowChunk - 1) / kRowChunk * box.dims[1] * box.dims[2];
+  ctx.queue().enqueueNDRangeKernel(sample, cl::NullRange, cl::NDRange((std::size_t(items) + kLocal - 1) / kLocal * kLocal),
+                                   cl::NDRange(kLocal));
+  ctx.queue().finish();
+  timer.lap("sample");
   out.ct_hu.resize(std::size_t(n_out));
   out.outcome.resize(std::size_t(n_out));
   static_assert(sizeof(WarpOutcome) == 1, "outcomes download as uchar");
@@ -128,8 +142,10 @@ WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource
     ctx.queue().enqueueReadBuffer(out_labels, CL_FALSE, 0, std::size_t(n_out) * sizeof(uint16_t), out.labels.data());
   }
   ctx.queue().finish();
+  timer.lap("download");
   for (WarpOutcome w : out.outcome)
     ++(w == WarpOutcome::Carried ? out.carried_voxels : w == WarpOutcome::Gas ? out.gas_voxels : out.kept_voxels);
+  timer.lap("count");
   return out;
 }
 

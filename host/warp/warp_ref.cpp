@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "core/progress.h"
+#include "warp/phase_timer.h"
 #include "warp/warp.h"
 #include "warp/warp_sampling.h"
 
@@ -59,9 +60,41 @@ RefTet prepare(const WarpMesh& m, int64_t t, const WarpBox& box) {
   return r;
 }
 
+/// The voxels of row (j, k) worth testing: where each barycentric weight, linear along the row, is
+/// ≥ −tolerance, widened by one voxel on each side so rounding in this estimate never drops a voxel
+/// the exact per-voxel test would take. Empty when first > last.
+std::pair<int64_t, int64_t> row_span(const RefTet& r, int64_t j, int64_t k) {
+  const Vec3 a = r.e_inv * (Vec3(double(r.lo[0]), double(j), double(k)) - r.x0);   // weights 1..3 at i = lo
+  const Vec3 b = r.e_inv.col(0);                                                   // their change per voxel
+  const double last = double(r.hi[0] - r.lo[0]);
+  double t_lo = 0.0, t_hi = last;
+  auto clip = [&](double ac, double bc) {   // ac + bc·t ≥ −tolerance
+    const double bound = (-kWarpTolerance - ac) / bc;
+    if (bc > 0) t_lo = std::max(t_lo, bound);
+    else if (bc < 0) t_hi = std::min(t_hi, bound);
+    else if (ac < -kWarpTolerance) t_hi = -1.0;
+  };
+  clip(1.0 - a.sum(), -b.sum());
+  for (int c = 0; c < 3; ++c) clip(a[c], b[c]);
+  if (!(t_lo <= t_hi + 2.0)) return {1, 0};
+  t_lo = std::clamp(t_lo, 0.0, last);
+  t_hi = std::clamp(t_hi, 0.0, last);
+  return {r.lo[0] + std::max<int64_t>(0, int64_t(std::ceil(t_lo)) - 1),
+          r.lo[0] + std::min<int64_t>(r.hi[0] - r.lo[0], int64_t(std::floor(t_hi)) + 1)};
+}
+
+/// Whether each cube of row (j, k) was meshed at rest, indexed by cube_of_i[i]; null when the row
+/// lies beyond the lattice.
+const uint8_t* rest_row(const WarpMesh& m, int64_t j, int64_t k) {
+  const int64_t b = j / m.cube_voxels, c = k / m.cube_voxels;
+  if (b >= m.cubes[1] || c >= m.cubes[2]) return nullptr;
+  return m.cube_meshed.data() + m.cubes[0] * (b + m.cubes[1] * c);
+}
+
 }  // namespace
 
 WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt) {
+  PhaseTimer timer("warp on cpu");
   const int64_t T = mesh.tet_count();
   std::vector<RefTet> tets(static_cast<std::size_t>(T));
 #pragma omp parallel for schedule(static)
@@ -77,6 +110,7 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
       by_slab[std::size_t(s)].push_back(int32_t(t));
   }
 
+  timer.lap("prepare");
   const SourceGrid grid{mesh.grid.dims, src.ct_hu, src.labels, src.roles};
   WarpResult out;
   out.device = "cpu";
@@ -86,6 +120,10 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
   out.outcome.resize(std::size_t(n_out));
 
   const int64_t nx = box.dims[0], ny = box.dims[1], plane = nx * ny;
+  // Cube column of each voxel column i (a table: an integer division per voxel costs more than the rest).
+  std::vector<int64_t> cube_of_i(std::size_t(mesh.grid.dims[0]));
+  for (int64_t i = 0; i < mesh.grid.dims[0]; ++i) cube_of_i[std::size_t(i)] = i / mesh.cube_voxels;
+  timer.lap("allocate");
   Progress progress("warp", slabs);
   std::atomic<int64_t> done{0};
 #pragma omp parallel
@@ -104,8 +142,9 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
       for (int32_t t : by_slab[std::size_t(s)]) {
         const RefTet& r = tets[std::size_t(t)];
         for (int64_t k = std::max(r.lo[2], k_begin); k <= std::min(r.hi[2], k_end - 1); ++k)
-          for (int64_t j = r.lo[1]; j <= r.hi[1]; ++j)
-            for (int64_t i = r.lo[0]; i <= r.hi[0]; ++i) {
+          for (int64_t j = r.lo[1]; j <= r.hi[1]; ++j) {
+            const auto [i_begin, i_end] = row_span(r, j, k);
+            for (int64_t i = i_begin; i <= i_end; ++i) {
               const Vec3 p = Vec3(double(i), double(j), double(k));
               const Vec3 w = r.e_inv * (p - r.x0);
               const double w0 = 1.0 - w[0] - w[1] - w[2];
@@ -120,10 +159,12 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
               owner[std::size_t(n)] = t;
               source[std::size_t(n)] = from;
             }
+          }
       }
       // 2. Sample, or decide gas / unchanged.
       for (int64_t k = k_begin; k < k_end; ++k)
-        for (int64_t j = box.lo[1]; j < box.lo[1] + ny; ++j)
+        for (int64_t j = box.lo[1]; j < box.lo[1] + ny; ++j) {
+          const uint8_t* meshed_row = rest_row(mesh, j, k);
           for (int64_t i = box.lo[0]; i < box.lo[0] + nx; ++i) {
             const int64_t n = (i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - k_begin));
             const int64_t o = (i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - box.lo[2]));
@@ -135,7 +176,7 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
               const Vec3& from = source[std::size_t(n)];
               hu = float(grid.ct_trilinear(from));
               if (src.labels) label = grid.label_nearest(from);
-            } else if (covered[std::size_t(n)] || mesh.in_rest_space(i, j, k)) {
+            } else if (covered[std::size_t(n)] || (meshed_row && meshed_row[cube_of_i[std::size_t(i)]])) {
               what = WarpOutcome::Gas;
               hu = opt.gas_hu;
               label = opt.cavity_label;
@@ -149,13 +190,16 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
             out.ct_hu[std::size_t(o)] = hu;
             if (src.labels) out.labels[std::size_t(o)] = label;
           }
+        }
       const int64_t d = ++done;
       if (omp_get_thread_num() == 0) progress.update(d);
     }
   }
   progress.finish();
+  timer.lap("scatter and sample");
   for (WarpOutcome w : out.outcome)
     ++(w == WarpOutcome::Carried ? out.carried_voxels : w == WarpOutcome::Gas ? out.gas_voxels : out.kept_voxels);
+  timer.lap("count");
   return out;
 }
 
