@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # README's first command: installs every dependency, builds, and runs the main job on the embedded
-# default case (the synthetic abdomen): phantom → roles → mesh → inflation at 12 mmHg.
+# default case (the synthetic abdomen): phantom → roles → mesh → inflation at 12 mmHg → warped CT.
 # Outputs land in out/demo (or the folder given as the first argument).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,4 +11,6 @@ out=${1:-out/demo}
 ./build/pneumo phantom --size small --out "$out" --force
 ./build/pneumo roles "$out/scene.json" --png "$out/roles.png"
 ./build/pneumo simulate "$out/scene.json" --out "$out" --force
-echo "demo: outputs in $out (roles.png, mesh_initial.vtu, mesh_deformed.vtu for ParaView, metrics.json)"
+./build/pneumo warp "$out/scene.json" --out "$out" --force
+echo "demo: outputs in $out (roles.png, mesh_initial.vtu, mesh_deformed.vtu for ParaView, deformed_ct.nii.gz,"
+echo "      deformed_labels.nii.gz for 3D Slicer or ITK-SNAP, slices_before_after.png, metrics.json)"

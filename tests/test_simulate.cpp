@@ -92,7 +92,8 @@ TEST(Simulate, WritesMeshesMetricsAndTheSceneUsed) {
   const Simulation sim = simulate_scene(scene);
   const std::string out = dir.file("out");
   write_simulation(scene, sim, out);
-  for (const char* f : {"mesh_initial.vtu", "mesh_deformed.vtu", "metrics.json", "convergence.csv", "scene_used.json"})
+  for (const char* f : {"mesh_initial.vtu", "mesh_deformed.vtu", "metrics.json", "convergence.csv", "scene_used.json",
+                        "deformation.bin"})
     EXPECT_TRUE(std::filesystem::exists(out + "/" + f)) << f;
   std::ifstream in(out + "/metrics.json");
   const auto m = nlohmann::json::parse(in);

@@ -16,5 +16,6 @@ Run add_roles(CLI::App& app);
 Run add_validate(CLI::App& app);
 Run add_simulate(CLI::App& app);
 Run add_render(CLI::App& app);
+Run add_warp(CLI::App& app);
 
 }  // namespace pneumo::cli

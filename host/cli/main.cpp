@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   add(cli::add_roles);
   add(cli::add_validate);
   add(cli::add_simulate);
+  add(cli::add_warp);
   add(cli::add_render);
 
   try {

@@ -10,6 +10,7 @@
 #include "core/log.h"
 #include "core/units.h"
 #include "cl/cl_runtime.h"
+#include "mesh/deformation_file.h"
 #include "mesh/vtu_writer.h"
 #include "report/plot_svg.h"
 #include "solve/solver_cl.h"
@@ -263,6 +264,13 @@ void write_simulation(const Scene& scene, const Simulation& sim, const std::stri
     write_text_file_atomic(path("pressure_volume.csv"), pv.str());
     write_text_file_atomic(path("pressure_volume.svg"), pressure_curve_plot_svg(sim.pressure_curve));
   }
+  // The solved shape for `pneumo warp` and later stages (deformation_file.h).
+  Deformation def;
+  def.displacement_m.resize(sim.result.x.size());
+  for (std::size_t n = 0; n < sim.result.x.size(); ++n) def.displacement_m[n] = sim.result.x[n] - sim.mesh.rest_m[n];
+  def.pressure_pa = sim.result.final_pressure_pa;
+  def.converged = sim.result.converged;
+  write_deformation(path("deformation.bin"), sim.mesh, def);
   // metrics.json last: its presence says the run finished.
   write_text_file_atomic(path("metrics.json"), simulation_metrics(scene, sim).dump(2) + "\n");
 }

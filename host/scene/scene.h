@@ -207,6 +207,9 @@ struct SceneOutput {
   bool write_meshes = false;
   bool write_deformed_ct = true;
   bool write_deformed_labels = true;
+  // Label id of the CO2 cavity in the warped label map (§7). TotalSegmentator's ids end at 117 and
+  // the phantom's own at 207; 250 is free in both. A label map that already uses it is refused.
+  int cavity_label = 250;
   bool write_slices = true;
   bool write_depth = false;
   int64_t timelapse_every_steps = 0;  // 0 = off

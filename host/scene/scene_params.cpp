@@ -317,6 +317,8 @@ const Table<SceneOutput>& output_table() {
       {"write_deformed_ct", &SceneOutput::write_deformed_ct, "", any(), "Write the warped CT (§7)."},
       {"write_deformed_labels", &SceneOutput::write_deformed_labels, "", any(),
        "Write the warped label map (with the cavity label) when a label map is given (§7)."},
+      {"cavity_label", &SceneOutput::cavity_label, "", in(1, 65535),
+       "Label id of the CO2 cavity in the warped label map (§7); must not be an id the label map uses."},
       {"write_slices", &SceneOutput::write_slices, "", any(), "Write before/after slice pairs (axial, coronal, sagittal)."},
       {"write_depth", &SceneOutput::write_depth, "", any(), "Write a depth map beside each view."},
       {"timelapse_every_steps", &SceneOutput::timelapse_every_steps, "", in(0, 1e9),

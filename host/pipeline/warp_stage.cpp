@@ -1,0 +1,190 @@
+#include "pipeline/warp_stage.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "core/units.h"
+#include "io/volume_io.h"
+#include "report/png.h"
+#include "report/slices.h"
+
+namespace pneumo {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string in_dir(const std::string& dir, const char* name) { return (fs::path(dir) / name).string(); }
+
+nlohmann::json read_metrics(const std::string& dir) {
+  const std::string path = in_dir(dir, "metrics.json");
+  std::ifstream is(path);
+  if (!is)
+    throw file_error(path, "missing: " + dir + " holds no finished simulation; run pneumo simulate SCENE --out " +
+                               dir + " first");
+  try {
+    return nlohmann::json::parse(is);
+  } catch (const nlohmann::json::exception& e) {
+    throw file_error(path, std::string("not valid JSON (") + e.what() + ")");
+  }
+}
+
+/// A world-space point for the slices: the mean position of the gas voxels.
+std::optional<Vec3> cavity_centroid(const WarpResult& r, const Geometry& g) {
+  Vec3 sum = Vec3::Zero();
+  int64_t n = 0;
+  for (int64_t k = 0; k < g.dims[2]; ++k)
+    for (int64_t j = 0; j < g.dims[1]; ++j)
+      for (int64_t i = 0; i < g.dims[0]; ++i)
+        if (r.outcome[std::size_t(g.linear_index(i, j, k))] == WarpOutcome::Gas) {
+          sum += Vec3(double(i), double(j), double(k));
+          ++n;
+        }
+  if (n == 0) return std::nullopt;
+  return g.to_world(sum / double(n));
+}
+
+template <class T>
+void fill_rounded(Volume& v, const std::vector<float>& hu) {
+  T* out = v.data<T>();
+  const double lo = double(std::numeric_limits<T>::lowest()), hi = double(std::numeric_limits<T>::max());
+  for (std::size_t n = 0; n < hu.size(); ++n) {
+    if constexpr (std::is_integral_v<T>) out[n] = T(std::clamp(std::nearbyint(double(hu[n])), lo, hi));
+    else out[n] = T(hu[n]);
+  }
+}
+
+}  // namespace
+
+WarpedCase warp_scene(const Scene& scene, const std::string& sim_dir) {
+  read_metrics(sim_dir);   // a finished simulation, before reading a large CT for nothing
+  WarpedCase w;
+  w.ct = read_volume(scene.require_ct());
+  if (!scene.inputs.labels.empty()) w.labels = read_volume(scene.inputs.labels);
+  w.roles = assign_roles(scene, w.ct, w.labels ? &*w.labels : nullptr);
+  const uint16_t cavity = uint16_t(scene.output.cavity_label);
+  if (w.labels)
+    for (uint16_t l : w.roles.label)
+      if (l == cavity)
+        throw file_error(scene.inputs.labels, "already uses label " + std::to_string(cavity) +
+                                                  ", the cavity's id; choose a free one with output.cavity_label");
+
+  w.mesh = build_scene_mesh(VoxelRoles{w.roles.geometry, w.roles.role.data(), w.roles.label.data()}, scene);
+  w.deformation = read_deformation(in_dir(sim_dir, "deformation.bin"), w.mesh);
+  const double scene_pa = units::mmhg_to_pa(scene.load.pressure_mmhg);
+  if (scene.load.pressure_curve_mmhg.empty() && std::abs(w.deformation.pressure_pa - scene_pa) > 1e-6 * scene_pa)
+    log::warn(sim_dir + ": the deformation was solved at " +
+              std::to_string(w.deformation.pressure_pa / units::kPaPerMmHg) + " mmHg, the scene now asks for " +
+              std::to_string(scene.load.pressure_mmhg) + " mmHg; warping the solved shape");
+  if (!w.deformation.converged) log::warn(sim_dir + ": the simulation did not converge; warping its last shape");
+  w.warp_mesh = make_warp_mesh(w.mesh, w.deformation.displacement_m);
+
+  WarpSource src;
+  src.ct_hu = w.roles.ct.data<float>();
+  src.labels = w.labels ? w.roles.label.data() : nullptr;
+  src.roles = w.roles.role.data();
+  WarpBox box;
+  box.lo = w.roles.pad.lo;
+  box.dims = w.ct.geometry().dims;
+  WarpOptions opt;
+  opt.cavity_label = cavity;
+  const auto t0 = std::chrono::steady_clock::now();
+  w.result = warp_on_device(scene.device, w.warp_mesh, src, box, opt);
+  w.seconds_warp = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const Vec3& s = w.ct.geometry().spacing_mm;
+  w.voxel_volume_ml = s[0] * s[1] * s[2] / 1000.0;
+  w.cavity_centroid_mm = cavity_centroid(w.result, w.ct.geometry());
+  return w;
+}
+
+Volume deformed_ct_volume(const WarpedCase& w) {
+  VoxelType t = w.ct.type();
+  if (t != VoxelType::Int16 && t != VoxelType::Int32 && t != VoxelType::Float32 && t != VoxelType::Float64)
+    t = VoxelType::Float32;
+  Volume v(w.ct.geometry(), t);
+  dispatch_voxel_type(t, v.raw(), [&](auto* p) {
+    using T = std::remove_pointer_t<decltype(p)>;
+    fill_rounded<T>(v, w.result.ct_hu);
+  });
+  return v;
+}
+
+Volume deformed_label_volume(const WarpedCase& w, int cavity_label) {
+  if (!w.labels) throw std::logic_error("deformed_label_volume: the case has no label map");
+  VoxelType t = w.labels->type();
+  bool fits = false;
+  dispatch_voxel_type(t, const_cast<void*>(w.labels->raw()), [&](auto* p) {
+    using T = std::remove_pointer_t<decltype(p)>;
+    fits = std::is_integral_v<T> && double(cavity_label) <= double(std::numeric_limits<T>::max());
+  });
+  if (!fits) t = VoxelType::UInt16;
+  Volume v(w.ct.geometry(), t);
+  dispatch_voxel_type(t, v.raw(), [&](auto* p) {
+    for (std::size_t n = 0; n < w.result.labels.size(); ++n) p[n] = static_cast<std::remove_pointer_t<decltype(p)>>(w.result.labels[n]);
+  });
+  return v;
+}
+
+nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
+  const double mvox_s = w.seconds_warp > 0 ? double(w.result.ct_hu.size()) / w.seconds_warp / 1e6 : 0.0;
+  nlohmann::json j;
+  j["cavity_voxels"] = w.cavity_voxels();
+  j["cavity_volume_ml"] = w.cavity_volume_ml();
+  j["warp"] = {{"device", w.result.device},
+               {"cavity_label", scene.output.cavity_label},
+               {"carried_voxels", w.result.carried_voxels},
+               {"gas_voxels", w.result.gas_voxels},
+               {"kept_voxels", w.result.kept_voxels},
+               {"seconds", w.seconds_warp},
+               {"mvoxels_per_s", mvox_s}};
+  if (w.cavity_centroid_mm) {
+    const Vec3& c = *w.cavity_centroid_mm;
+    j["warp"]["cavity_centroid_mm"] = {c[0], c[1], c[2]};
+  }
+  return j;
+}
+
+void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir) {
+  nlohmann::json metrics = read_metrics(dir);
+  check_writable_target(in_dir(dir, "metrics.json"));
+  if (scene.output.write_deformed_ct) write_volume(deformed_ct_volume(w), in_dir(dir, "deformed_ct.nii.gz"));
+  if (scene.output.write_deformed_labels && w.labels)
+    write_volume(deformed_label_volume(w, scene.output.cavity_label), in_dir(dir, "deformed_labels.nii.gz"));
+  if (scene.output.write_slices) {
+    const Volume after = deformed_ct_volume(w);
+    std::vector<uint8_t> gas(w.result.outcome.size());
+    for (std::size_t n = 0; n < gas.size(); ++n) gas[n] = w.result.outcome[n] == WarpOutcome::Gas;
+    SliceOverlay overlay;
+    overlay.geometry = w.ct.geometry();
+    overlay.classes = gas.data();
+    char name[96];
+    std::snprintf(name, sizeof name, "CO2 cavity %.0f ml", w.cavity_volume_ml());
+    overlay.table = {{"", {0, 0, 0}, 0.0}, {name, {60, 160, 255}, 0.35}};
+    SliceView view;
+    view.point_mm = w.cavity_centroid_mm;
+    view.title = "before";
+    const RgbImage before = render_slice_row(w.ct, nullptr, view);
+    char title[160];
+    std::snprintf(title, sizeof title, "after, %.1f mmHg (cavity in blue)",
+                  w.deformation.pressure_pa / units::kPaPerMmHg);
+    view.title = title;
+    write_png(in_dir(dir, "slices_before_after.png"),
+              stack_rows({before, render_slice_row(after, &overlay, view), render_legend(overlay.table)}));
+  }
+  // The mesh's own estimate (from simulate) keeps a name of its own once the warp has counted voxels.
+  if (!metrics.contains("mesh_cavity_volume_ml") && metrics.contains("cavity_volume_ml"))
+    metrics["mesh_cavity_volume_ml"] = metrics["cavity_volume_ml"];
+  metrics.update(warp_metrics(scene, w));
+  if (metrics.contains("stage_seconds") && metrics["stage_seconds"].is_object())
+    metrics["stage_seconds"]["warp"] = w.seconds_warp;
+  write_text_file_atomic(in_dir(dir, "metrics.json"), metrics.dump(2) + "\n");
+}
+
+}  // namespace pneumo

@@ -1,0 +1,60 @@
+#pragma once
+// The warp stage of a case: what `pneumo warp SCENE --out DIR` runs after `pneumo simulate SCENE
+// --out DIR`, and what the pipeline reuses. Rebuilds roles and mesh from the scene (deterministic),
+// reads DIR/deformation.bin (refused when it belongs to another mesh), warps the CT and labels
+// (method.md §7) on the scene's device, and writes the results on the input CT's own grid.
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "io/volume.h"
+#include "mesh/deformation_file.h"
+#include "mesh/mesh.h"
+#include "roles/roles.h"
+#include "scene/scene.h"
+#include "warp/point_map.h"
+#include "warp/warp.h"
+
+namespace pneumo {
+
+struct WarpedCase {
+  Volume ct;                      // the input CT as read (its grid and type are the outputs')
+  std::optional<Volume> labels;   // the input label map, when the scene gives one
+  RoleVolume roles;               // on the working (padded) grid
+  Mesh mesh;
+  Deformation deformation;
+  WarpMesh warp_mesh;
+  WarpResult result;              // on the CT's grid
+  double voxel_volume_ml = 0.0;
+  std::optional<Vec3> cavity_centroid_mm;   // none when no voxel became gas
+  double seconds_warp = 0.0;
+
+  int64_t cavity_voxels() const { return result.gas_voxels; }
+  double cavity_volume_ml() const { return double(result.gas_voxels) * voxel_volume_ml; }
+  /// Landmarks, ports and centroids through the same tetrahedra (point_map.h). The map refers to
+  /// this case's warp_mesh and roles: keep the case alive while using it.
+  PointMap point_map() const { return PointMap(warp_mesh, roles.role.data()); }
+};
+
+/// Everything but the writing. `sim_dir` holds a finished simulation of this scene (metrics.json
+/// and deformation.bin); InputError naming the file otherwise, or when the label map already uses
+/// output.cavity_label.
+WarpedCase warp_scene(const Scene& scene, const std::string& sim_dir);
+
+/// The deformed CT in the input's voxel type where it can hold HU (int16, int32 rounded to the
+/// nearest HU; float32, float64 as computed), float32 otherwise (unsigned or 8-bit types).
+Volume deformed_ct_volume(const WarpedCase& w);
+/// The deformed label map in the input's type when it holds the cavity label, else uint16.
+Volume deformed_label_volume(const WarpedCase& w, int cavity_label);
+
+/// The keys the warp adds to metrics.json (see write_warp).
+nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w);
+
+/// Writes deformed_ct.nii.gz, deformed_labels.nii.gz (with a label map) and slices_before_after.png
+/// as the scene's output.write_* ask, then adds warp_metrics() to DIR/metrics.json: cavity_voxels
+/// and cavity_volume_ml become the warped cavity's, the mesh's own estimate stays as
+/// mesh_cavity_volume_ml. Every file is written atomically, metrics.json last.
+void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir);
+
+}  // namespace pneumo

@@ -1,0 +1,72 @@
+#pragma once
+// The barycentric image warp (method.md §7; Kitasaka §2.5, Nimura §2.4): the deformed CT and label
+// map from the rest and deformed meshes. Two implementations behind one interface: warp_ref (plain
+// C++, double precision, OpenMP over slabs, the oracle) and warp_opencl (kernels/warp.cl, float).
+//
+// For each output voxel centre P′ (index coordinates of the working grid, warp_mesh.h):
+//  1. Scatter: each deformed tetrahedron visits the voxel centres of its bounding box; P′ is inside
+//     when its barycentric weights w are all ≥ −kWarpTolerance. Its source point is
+//     P = P′ − (d₀ + Σ_{i=1..3} w_i (d_i − d₀)), d the node displacements: the same affine map as
+//     P = Σ w_i x_i(0), written so that equal displacements cancel exactly.
+//  2. Acceptance: a wall tetrahedron takes P only if the role at P (nearest voxel) is not viscera,
+//     a viscera tetrahedron only if it is not wall. This splits doubled cubes along the true
+//     interface. Of several accepting tetrahedra the lowest index wins (any rule independent of
+//     the visiting order keeps the result deterministic; on shared faces the map is continuous,
+//     so which one wins changes nothing but rounding).
+//  3. Sampling: CT trilinear at P, label nearest at P. A source outside the working grid reads
+//     air: −1000 HU, label 0, role other (what the roles' padding holds).
+//  4. No accepted tetrahedron: gas (−1000 HU, the cavity label) when the voxel is inside the space
+//     the meshes occupied before (a cube meshed at rest) or after (inside some deformed
+//     tetrahedron) deformation; otherwise the voxel keeps its own value.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cl/cl_runtime.h"
+#include "scene/scene.h"
+#include "warp/warp_mesh.h"
+
+namespace pneumo {
+
+/// What the warp samples: the working grid's voxels (WarpMesh::grid), i fastest.
+struct WarpSource {
+  const float* ct_hu = nullptr;
+  const uint16_t* labels = nullptr;   // null: no label output
+  const Role* roles = nullptr;        // required: acceptance reads it
+};
+
+/// The output box, in voxels of the working grid: the CT's own grid inside the padded one.
+struct WarpBox {
+  Index3 lo{0, 0, 0};
+  Index3 dims{1, 1, 1};
+  int64_t voxel_count() const { return dims[0] * dims[1] * dims[2]; }
+};
+
+struct WarpOptions {
+  uint16_t cavity_label = 250;
+  float gas_hu = -1000.0f;
+};
+
+/// What happened at each output voxel.
+enum class WarpOutcome : uint8_t { Kept = 0, Carried = 1, Gas = 2 };
+
+struct WarpResult {
+  std::vector<float> ct_hu;          // box voxels, i fastest
+  std::vector<uint16_t> labels;      // box voxels; empty when the source has no labels
+  std::vector<WarpOutcome> outcome;  // box voxels
+  int64_t carried_voxels = 0, gas_voxels = 0, kept_voxels = 0;
+  std::string device;                // "cpu" or "opencl:P:D <name>"
+};
+
+/// The CPU reference. Deterministic for any thread count. Shows Progress("warp").
+WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt);
+
+/// kernels/warp.cl on a device, float32. Checks the device's memory first (ctx.check_fits).
+WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,
+                       const WarpOptions& opt);
+
+/// warp_ref for "cpu", warp_opencl for "opencl" / "opencl:P:D" (InputError for anything else).
+WarpResult warp_on_device(const std::string& device, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,
+                          const WarpOptions& opt);
+
+}  // namespace pneumo

@@ -1,0 +1,56 @@
+#pragma once
+// The mesh as the image warp sees it (method.md §7): tetrahedra with their rest and deformed node
+// positions in the continuous voxel-index coordinates of the working grid (the roles' grid, padding
+// included), and which lattice cubes the meshes filled at rest.
+//
+// Index coordinates: voxel (i,j,k)'s centre is the point (i,j,k); a cube of L voxels spans
+// [aL − ½, (a+1)L − ½) on each axis (mesh_build.cpp's node placement). Working there turns world
+// geometry (spacing, origin, an oblique or flipped direction) into plain arithmetic once, on the
+// host, in double precision.
+//
+// The deformation is carried as displacements, not positions: a uniform displacement gives every
+// node bit-identical index displacements, so a translation by whole voxels stays exactly whole
+// (the warp's exactness tests rely on it), and rounding never mixes the node's absolute position
+// (hundreds of voxels) into the small quantity that moves it.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/geometry.h"
+#include "mesh/mesh.h"
+
+namespace pneumo {
+
+struct WarpMesh {
+  Geometry grid;                                  // the working grid the indices refer to
+  std::vector<Vec3> rest_ijk;                     // rest node positions, index coordinates
+  std::vector<Vec3> disp_ijk;                     // node displacements, index units
+  std::vector<std::array<int32_t, 4>> tets;
+  std::vector<Part> tet_part;
+  // Rest space: the lattice cubes holding any tetrahedron; a voxel lies in it iff its cube does.
+  int cube_voxels = 0;
+  std::array<int64_t, 3> cubes{0, 0, 0};
+  std::vector<uint8_t> cube_meshed;               // cubes[0]·cubes[1]·cubes[2], a fastest
+
+  int64_t tet_count() const { return int64_t(tets.size()); }
+  Vec3 deformed_ijk(int32_t node) const { return rest_ijk[node] + disp_ijk[node]; }
+  /// Whether working-grid voxel (i,j,k) lies in a cube the meshes filled at rest.
+  bool in_rest_space(int64_t i, int64_t j, int64_t k) const;
+};
+
+/// The warp mesh of `mesh` displaced by `displacement_m` (metres, one per node, world RAS+).
+/// std::invalid_argument when the sizes differ.
+WarpMesh make_warp_mesh(const Mesh& mesh, const std::vector<Vec3>& displacement_m);
+
+/// A deformed tetrahedron too flat to invert (|det| of its edge matrix below 1e-9 of its edge
+/// length cubed): it covers no voxel centre in a way that could be sampled. Both the reference and
+/// the device skip exactly the tetrahedra this names, so they never disagree about them.
+bool warp_tet_degenerate(const WarpMesh& m, int64_t tet);
+
+/// The containment tolerance on barycentric weights: a voxel centre belongs to a tetrahedron when
+/// every weight is ≥ −kWarpTolerance. Voxel centres lie exactly on the lattice's face diagonals,
+/// and rounding may put one a few 1e-7 outside both tetrahedra sharing a face; 1e-4 covers that
+/// with room, and extrapolates the map by at most 1e-4 of an edge (1e-3 voxel for L = 8).
+constexpr double kWarpTolerance = 1e-4;
+
+}  // namespace pneumo
