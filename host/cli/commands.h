@@ -16,6 +16,7 @@ Run add_roles(CLI::App& app);
 Run add_validate(CLI::App& app);
 Run add_simulate(CLI::App& app);
 Run add_render(CLI::App& app);
+Run add_run(CLI::App& app);
 Run add_warp(CLI::App& app);
 
 }  // namespace pneumo::cli

@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   add(cli::add_simulate);
   add(cli::add_warp);
   add(cli::add_render);
+  add(cli::add_run);
 
   try {
     app.parse(argc, argv);

@@ -142,6 +142,18 @@ std::string phantom_scene_json(PhantomSize size) {
                 {"unlisted_label_role", "other"}};
   j["mesh"] = {{"cube_voxels", phantom_cube_voxels(size)}};
   j["load"] = {{"pressure_mmhg", 12}};
+  // Views. The torso's anterior skin is at y = 110 mm (TorsoModel), the wall under it 20–30 mm thick;
+  // at 12 mmHg the wall rises by 20–30 mm and a gas layer opens over the viscera, whose anterior surface
+  // stays near y = 85 mm. The port enters below the umbilicus and aims at the liver (label 5) on the
+  // patient's right; 45 mm along that oblique axis puts the tip through the inflated wall into the gas.
+  // The camera's tip is in the deformed frame: in the gas layer, looking up the abdomen.
+  j["render"] = {
+      {"width", 512},
+      {"height", 384},
+      {"ports",
+       {{{"name", "umbilical_port"}, {"skin_point_mm", {0, 110, -20}}, {"target_label", 5}, {"insertion_mm", 45},
+         {"oblique_deg", 30}}}},
+      {"cameras", {{{"name", "cavity_superior"}, {"position_mm", {0, 96, -90}}, {"look_at_mm", {20, 80, 40}}}}}};
   return j.dump(2);
 }
 

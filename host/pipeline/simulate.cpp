@@ -26,7 +26,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 const Vec3 kAnterior(0.0, 1.0, 0.0);
 }  // namespace
 
-Simulation simulate_scene(const Scene& scene) {
+Simulation prepare_simulation(const Scene& scene) {
   Simulation sim;
   auto t0 = std::chrono::steady_clock::now();
   sim.roles = load_roles(scene);
@@ -44,8 +44,17 @@ Simulation simulate_scene(const Scene& scene) {
   if (s.cavity_triangles == 0)
     throw InputError("scene " + scene.path + ": the mesh has no cavity triangles (no wall/viscera interface): the gas "
                      "has nowhere to act; check the role mapping (roles.*_labels) and mesh.model");
+  return sim;
+}
 
-  t0 = std::chrono::steady_clock::now();
+Simulation simulate_scene(const Scene& scene) {
+  Simulation sim = prepare_simulation(scene);
+  solve_simulation(scene, sim);
+  return sim;
+}
+
+void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hooks) {
+  const auto t0 = std::chrono::steady_clock::now();
   const ocl::DeviceSpec device = ocl::parse_device_spec(scene.device);
   std::shared_ptr<ocl::Context> ctx;
   if (device.use_opencl) {
@@ -58,9 +67,13 @@ Simulation simulate_scene(const Scene& scene) {
   auto run = [&](const SolveOptions& opt, const std::vector<Vec3>& x_start) {
     return ctx ? solve_opencl(*ctx, sim.mesh, opt, x_start) : solve(sim.mesh, opt, x_start);
   };
-  const SolveOptions base = solve_options_from_scene(scene);
+  SolveOptions base = solve_options_from_scene(scene);
+  base.snapshot_every_steps = hooks.snapshot_every_steps;
+  base.on_snapshot = hooks.on_snapshot;
   if (scene.load.pressure_curve_mmhg.empty()) {
-    sim.result = run(base, {});
+    SolveOptions opt = base;
+    opt.start_pressure_pa = hooks.start_pressure_pa;
+    sim.result = run(opt, hooks.x_start);
   } else {
     std::vector<double> pressures = scene.load.pressure_curve_mmhg;
     pressures.push_back(scene.load.pressure_mmhg);
@@ -101,7 +114,6 @@ Simulation simulate_scene(const Scene& scene) {
     }
   }
   sim.stage_seconds_solve = seconds_since(t0);
-  return sim;
 }
 
 DeformationMetrics deformation_metrics(const Mesh& m, const std::vector<Vec3>& x) {

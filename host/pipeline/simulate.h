@@ -26,10 +26,26 @@ struct Simulation {
   double stage_seconds_roles = 0, stage_seconds_mesh = 0, stage_seconds_solve = 0;
 };
 
-/// Runs roles, mesh and the scene's solver on the scene's device (the CPU reference or OpenCL).
-/// With load.pressure_curve_mmhg, every listed pressure and load.pressure_mmhg are solved in
-/// increasing order, each from the previous equilibrium. A DivergedError propagates.
+/// Runs roles, mesh and the scene's solver on the scene's device (the CPU reference or OpenCL):
+/// prepare_simulation then solve_simulation. A DivergedError propagates.
 Simulation simulate_scene(const Scene& scene);
+
+/// Roles and mesh (InputError when the mesh has no cavity triangles).
+Simulation prepare_simulation(const Scene& scene);
+
+/// What a caller adds to a solve: a start state (a resumed run's checkpoint) and an observer of
+/// the solver's progress (checkpoints, the inflation preview).
+struct SolveHooks {
+  std::vector<Vec3> x_start;            // empty: the rest positions
+  double start_pressure_pa = 0.0;       // the pressure x_start was reached at
+  int64_t snapshot_every_steps = 0;
+  std::function<void(const SolverSnapshot&)> on_snapshot;
+};
+
+/// The scene's solver on its device, into sim.result. With load.pressure_curve_mmhg, every listed
+/// pressure and load.pressure_mmhg are solved in increasing order, each from the previous
+/// equilibrium (the start state then applies to none: a curve starts from rest).
+void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hooks = {});
 
 /// Plausibility measures of a solved mesh (method.md §9): displacements of the wall, the largest
 /// anterior rise of the wall, and the gas volume opened between the wall and the viscera.

@@ -1,0 +1,156 @@
+#include "pipeline/run.h"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "core/units.h"
+#include "evaluate/landmarks.h"
+#include "mesh/deformation_file.h"
+#include "pipeline/render_scene.h"
+#include "pipeline/simulate.h"
+#include "pipeline/warp_stage.h"
+#include "report/report_html.h"
+
+namespace pneumo {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// What a run writes at the top of its folder, and the folders it fills: an earlier run's copies are
+/// removed before a forced run, so nothing stale sits beside the new results.
+const char* const kRunFiles[] = {"report.html",       "metrics.json",           "render.json",
+                                 "deformed_ct.nii.gz", "deformed_labels.nii.gz", "slices_before_after.png",
+                                 "mesh_initial.vtu",  "mesh_deformed.vtu",      "deformation.bin",
+                                 "convergence.csv",   "convergence.svg",        "pressure_volume.csv",
+                                 "pressure_volume.svg", "scene_used.json",      "roles.png"};
+const char* const kRunFolders[] = {"views", "flythrough"};
+
+void prepare_folder(const RunOptions& o) {
+  const fs::path out(o.out_dir);
+  bool earlier = false;
+  for (const char* f : kRunFiles) earlier |= fs::exists(out / f);
+  for (const char* f : kRunFolders) earlier |= fs::exists(out / f);
+  if (earlier && !o.force && !o.resume)
+    throw InputError(o.out_dir + ": already holds results of a run; use --force to replace them or --resume to "
+                                 "continue an interrupted one");
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) throw InputError(o.out_dir + ": cannot create the output folder (" + ec.message() + ")");
+  check_writable_target((out / "report.html").string());
+  // report.html goes first, so that an interrupted run never leaves the old one looking current.
+  for (const char* f : kRunFiles) fs::remove(out / f, ec);
+  for (const char* f : kRunFolders) fs::remove_all(out / f, ec);
+}
+
+std::vector<Vec3> displacements(const Mesh& m, const std::vector<Vec3>& x) {
+  std::vector<Vec3> u(x.size());
+  for (std::size_t n = 0; n < x.size(); ++n) u[n] = x[n] - m.rest_m[n];
+  return u;
+}
+
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream is(path);
+  const auto j = nlohmann::json::parse(is, nullptr, false);
+  if (j.is_discarded()) throw file_error(path, "not valid JSON");
+  return j;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream is(path);
+  return std::string((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
+}
+
+}  // namespace
+
+RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
+  const auto t_run = std::chrono::steady_clock::now();
+  prepare_folder(o);
+  const fs::path out(o.out_dir);
+  const std::string checkpoint = (out / "checkpoint.bin").string();
+
+  // Simulate: roles, mesh, solver (from the checkpoint with --resume).
+  log::info("stage 1/4: roles, mesh and solver");
+  Simulation sim = prepare_simulation(scene);
+  SolveHooks hooks;
+  if (o.resume && fs::exists(checkpoint)) {
+    const Deformation c = read_deformation(checkpoint, sim.mesh);
+    hooks.x_start.resize(c.displacement_m.size());
+    for (std::size_t n = 0; n < hooks.x_start.size(); ++n) hooks.x_start[n] = sim.mesh.rest_m[n] + c.displacement_m[n];
+    hooks.start_pressure_pa = c.pressure_pa;
+    log::info("resuming from " + checkpoint + " at " + std::to_string(c.pressure_pa / units::kPaPerMmHg) + " mmHg");
+  } else if (o.resume) {
+    log::info("no checkpoint in " + o.out_dir + ": starting from rest");
+  }
+  if (scene.solver.checkpoint_every_steps > 0) {
+    hooks.snapshot_every_steps = scene.solver.checkpoint_every_steps;
+    hooks.on_snapshot = [&](const SolverSnapshot& s) {
+      Deformation d;
+      d.displacement_m = displacements(sim.mesh, s.x);
+      d.pressure_pa = s.pressure_pa;
+      write_deformation(checkpoint, sim.mesh, d);
+    };
+  }
+  solve_simulation(scene, sim, hooks);
+  write_simulation(scene, sim, o.out_dir);
+  std::error_code ec;
+  fs::remove(checkpoint, ec);   // the finished solve's shape is deformation.bin now
+
+  // Warp, then render with the warp's point mapping (ports travel with the skin).
+  log::info("stage 2/4: warp");
+  const WarpedCase w = warp_scene(scene, o.out_dir);
+  write_warp(scene, w, o.out_dir);
+  const PointMap point_map = w.point_map();
+  const PointMapFn map = [&point_map](const Vec3& p) -> Vec3 { return point_map.to_deformed(p).point_mm; };
+
+  log::info("stage 3/4: render");
+  const auto t_render = std::chrono::steady_clock::now();
+  RenderOptions ro;
+  ro.out_dir = o.out_dir;
+  ro.backend = o.backend;
+  ro.map_point = map;
+  const RenderRun rendered = render_scene(scene, ro);
+  const double seconds_render = seconds_since(t_render);
+
+  // Report: landmarks, plots, metrics (complete), report.html last.
+  log::info("stage 4/4: report");
+  const auto t_report = std::chrono::steady_clock::now();
+  nlohmann::json metrics = read_json((out / "metrics.json").string());
+  if (!scene.landmarks.empty()) metrics["landmarks"] = to_json(evaluate_landmarks(scene.landmarks, map));
+  metrics["render"] = {{"views", rendered.views}, {"frames", rendered.frames}, {"deformed_ct", rendered.deformed}};
+  ReportContent rc;
+  rc.title = "pneumo: " + (scene.name.empty() ? scene.path : scene.name);
+  rc.scene = scene.echo();
+  rc.plots.push_back({"Convergence", read_text((out / "convergence.svg").string())});
+  if (!sim.pressure_curve.empty())
+    rc.plots.push_back({"Pressure-volume curve", read_text((out / "pressure_volume.svg").string())});
+  if (fs::exists(out / "slices_before_after.png"))
+    rc.images.push_back({"Before and after (axial, coronal, sagittal)", (out / "slices_before_after.png").string()});
+  for (const std::string& f : rendered.files)
+    if (f.rfind("views/", 0) == 0 && f.find("_depth") == std::string::npos)
+      rc.images.push_back({f.substr(6, f.size() - 10), (out / f).string()});
+  metrics["stage_seconds"]["render"] = seconds_render;
+  metrics["stage_seconds"]["report"] = seconds_since(t_report);
+  metrics["stage_seconds"]["total"] = seconds_since(t_run);
+  metrics["pipeline_complete"] = true;
+  rc.metrics = metrics;
+  write_text_file_atomic((out / "metrics.json").string(), metrics.dump(2) + "\n");
+  const std::string report = (out / "report.html").string();
+  write_text_file_atomic(report, report_html(rc));
+
+  RunSummary summary;
+  summary.metrics = metrics;
+  summary.report_path = report;
+  summary.converged = sim.result.converged;
+  return summary;
+}
+
+}  // namespace pneumo
