@@ -75,7 +75,7 @@ TEST(RunPipeline, SmallPhantomEndToEnd) {
   const fs::path out(o.out_dir);
   for (const char* f : {"deformed_ct.nii.gz", "deformed_labels.nii.gz", "mesh_initial.vtu", "mesh_deformed.vtu",
                         "slices_before_after.png", "metrics.json", "report.html", "convergence.svg",
-                        "convergence.csv", "scene_used.json", "render.json", "deformation.bin"})
+                        "convergence.csv", "scene_used.json", "render.json", "deformation.bin", "roles.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   EXPECT_FALSE(fs::exists(out / "checkpoint.bin")) << "a finished run leaves no checkpoint";
   const Volume ct = read_volume(scene.require_ct());
@@ -107,7 +107,7 @@ TEST(RunPipeline, SmallPhantomEndToEnd) {
   for (std::size_t at = html.find("data:image/png;base64,"); at != std::string::npos;
        at = html.find("data:image/png;base64,", at + 1))
     ++images;
-  EXPECT_EQ(images, 5);   // the slices and the 4 views
+  EXPECT_EQ(images, 6);   // the roles, the slices and the 4 views
   EXPECT_NE(html.find("<svg"), std::string::npos);
 }
 

@@ -14,6 +14,7 @@
 #include "pipeline/simulate.h"
 #include "pipeline/warp_stage.h"
 #include "report/report_html.h"
+#include "roles/role_png.h"
 
 namespace pneumo {
 
@@ -99,6 +100,7 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
       write_deformation(checkpoint, sim.mesh, d);
     };
   }
+  write_roles_png(sim.roles, (out / "roles.png").string());
   solve_simulation(scene, sim, hooks);
   write_simulation(scene, sim, o.out_dir);
   std::error_code ec;
@@ -132,6 +134,7 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   rc.plots.push_back({"Convergence", read_text((out / "convergence.svg").string())});
   if (!sim.pressure_curve.empty())
     rc.plots.push_back({"Pressure-volume curve", read_text((out / "pressure_volume.svg").string())});
+  rc.images.push_back({"Roles: wall orange, viscera green, fixed blue", (out / "roles.png").string()});
   if (fs::exists(out / "slices_before_after.png"))
     rc.images.push_back({"Before and after (axial, coronal, sagittal)", (out / "slices_before_after.png").string()});
   for (const std::string& f : rendered.files)
