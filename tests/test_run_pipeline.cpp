@@ -60,7 +60,7 @@ TEST(RunPipeline, SmallPhantomEndToEnd) {
   // volumes on the input CT's grid), and the results against physics: the wall rises (> 5 mm: see the
   // simulate tests), a cavity opens (> 50 ml of warped gas), no tetrahedron inverts, every view shows
   // something (≥ 10 % lit pixels: a view of the gas layer shows its walls everywhere; the exterior views show
-  // the body), landmarks carried (the umbilicus moves anteriorly, a fixed vertebra not at all).
+  // the body), landmarks carried; the inflation preview drawn (the umbilicus moves anteriorly, a fixed vertebra not at all).
   ScratchDir dir;
   Scene scene = small_phantom(dir);
   scene.solver.checkpoint_every_steps = 50;
@@ -72,8 +72,22 @@ TEST(RunPipeline, SmallPhantomEndToEnd) {
   scene.landmarks = {umbilicus, vertebra};
   RunOptions o;
   o.out_dir = dir.file("run");
+  o.timelapse_every_steps = 150;
   const RunSummary s = run_pipeline(scene, o);
   const fs::path out(o.out_dir);
+  // The inflation preview: frames of the first view and the exterior views; the first (at rest) and the
+  // last (inflated) differ.
+  for (const char* view : {"cavity_superior", "exterior_anterior"}) {
+    const fs::path d = out / "timelapse" / view;
+    int frames = 0;
+    for (const auto& e : fs::directory_iterator(d)) frames += e.path().extension() == ".png";
+    EXPECT_GE(frames, 3) << view;
+    std::ifstream a(d / "frame_0001.png", std::ios::binary), b(d / ("frame_000" + std::to_string(frames) + ".png"),
+                                                                   std::ios::binary);
+    const std::string first((std::istreambuf_iterator<char>(a)), {}), last((std::istreambuf_iterator<char>(b)), {});
+    EXPECT_FALSE(first.empty());
+    EXPECT_NE(first, last) << view;
+  }
   for (const char* f : {"deformed_ct.nii.gz", "deformed_labels.nii.gz", "mesh_initial.vtu", "mesh_deformed.vtu",
                         "slices_before_after.png", "metrics.json", "report.html", "convergence.svg",
                         "convergence.csv", "scene_used.json", "render.json", "deformation.bin", "roles.png"})

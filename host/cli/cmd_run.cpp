@@ -9,7 +9,11 @@ namespace pneumo::cli {
 Run add_run(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "run", "The whole case: roles, mesh, solver, warp, render and report.html into --out (what the demo runs)");
-  struct Opts { std::string scene, out, device, backend = "auto"; bool force = false, resume = false; };
+  struct Opts {
+    std::string scene, out, device, backend = "auto";
+    bool force = false, resume = false;
+    int64_t timelapse = -1;
+  };
   auto o = std::make_shared<Opts>();
   cmd->add_option("scene", o->scene, "Scene .json")->required();
   cmd->add_option("--out", o->out, "Output folder")->required();
@@ -17,6 +21,10 @@ Run add_run(CLI::App& app) {
   cmd->add_option("--backend", o->backend, "Offscreen OpenGL: auto, egl-device, egl-surfaceless or osmesa");
   cmd->add_flag("--force", o->force, "Replace the results of an earlier run in --out");
   cmd->add_flag("--resume", o->resume, "Continue an interrupted run in --out from its checkpoint.bin");
+  cmd->add_option("--timelapse", o->timelapse,
+                  "Inflation preview: warp and render the first view and the exterior views every N solver steps "
+                  "into --out/timelapse (overrides output.timelapse_every_steps; 0: off)")
+      ->check(CLI::Range(int64_t(0), int64_t(1000000000)));
   return [=] {
     Scene scene = load_scene(o->scene);
     if (!o->device.empty()) scene.device = o->device;
@@ -25,6 +33,7 @@ Run add_run(CLI::App& app) {
     ro.out_dir = o->out;
     ro.force = o->force;
     ro.resume = o->resume;
+    ro.timelapse_every_steps = o->timelapse;
     ro.backend = parse_gl_backend(o->backend);
     const RunSummary s = run_pipeline(scene, ro);
     const auto& m = s.metrics;

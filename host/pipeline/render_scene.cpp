@@ -84,6 +84,8 @@ nlohmann::json pose_json(const ViewCamera& c) {
           {"lens", enum_name(c.lens)},         {"fov_deg", c.fov_deg}};
 }
 
+}  // namespace
+
 bool ffmpeg_available() { return std::system("command -v ffmpeg >/dev/null 2>&1") == 0; }
 
 // frames → <dir>.mp4 (H.264, 25 frames/s); written beside and renamed, so it is atomic too.
@@ -102,10 +104,7 @@ bool encode_mp4(const fs::path& frame_dir, const fs::path& mp4) {
   return true;
 }
 
-}  // namespace
-
 RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
-  const auto start = std::chrono::steady_clock::now();
   const SceneRender& r = scene.render;
   RenderRun run;
   const fs::path out(opt.out_dir);
@@ -121,14 +120,24 @@ RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
     run.ct_path = scene.require_ct();
     run.labels_path = scene.inputs.labels;
   }
-  const PointMapFn map = opt.map_point ? opt.map_point : identity_point_map();
   scene_transfer_function(r);  // a bad custom transfer function is reported before the CT is read
 
   log::info("render: " + run.ct_path + (run.labels_path.empty() ? "" : " with labels " + run.labels_path));
   const Volume ct = read_volume(run.ct_path);
   std::unique_ptr<Volume> labels;
   if (!run.labels_path.empty()) labels = std::make_unique<Volume>(read_volume(run.labels_path));
-  const RenderVolume volume = RenderVolume::from(ct, labels.get());
+  return render_volumes(scene, opt, ct, labels.get(), run);
+}
+
+RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Volume& ct, const Volume* labels,
+                         RenderRun run) {
+  const auto start = std::chrono::steady_clock::now();
+  const SceneRender& r = scene.render;
+  const fs::path out(opt.out_dir);
+  const fs::path deformed_labels = out / "deformed_labels.nii.gz";
+  const PointMapFn map = opt.map_point ? opt.map_point : identity_point_map();
+  scene_transfer_function(r);
+  const RenderVolume volume = RenderVolume::from(ct, labels);
   const RenderSettings s = settings_from_scene(r, volume.geometry);
 
   // Poses first: every bad one is reported before any rendering.

@@ -11,11 +11,13 @@
 //   views/exterior_anterior.png, views/exterior_left.png   (render.exterior_views)
 //   flythrough/<path>/frame_0001.png ...  and flythrough/<path>.mp4 when ffmpeg is on PATH
 //   render.json                      volume used, GL back end/version/renderer, poses, files
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "io/volume.h"
 #include "render/gl_context.h"
 #include "render/poses.h"
 #include "scene/scene.h"
@@ -40,5 +42,15 @@ struct RenderRun {
 /// Renders everything; InputError for bad input (no CT, a tip outside the volume, an unknown
 /// target label, ...). Shows Progress over the frames.
 RenderRun render_scene(const Scene& scene, const RenderOptions& options);
+
+/// The same from volumes in memory (the inflation preview renders each warped frame); `run`
+/// carries what the report names (the volumes' paths, whether they are deformed).
+RenderRun render_volumes(const Scene& scene, const RenderOptions& options, const Volume& ct, const Volume* labels,
+                         RenderRun run);
+
+/// Whether ffmpeg is on PATH, and frames frame_0001.png … in `frame_dir` → `mp4` (H.264, 25 frames/s,
+/// written beside and renamed; false with a warning when ffmpeg fails).
+bool ffmpeg_available();
+bool encode_mp4(const std::filesystem::path& frame_dir, const std::filesystem::path& mp4);
 
 }  // namespace pneumo

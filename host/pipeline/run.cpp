@@ -1,6 +1,8 @@
 #include "pipeline/run.h"
 
 #include <chrono>
+#include <climits>
+#include <memory>
 #include <filesystem>
 #include <fstream>
 
@@ -12,6 +14,7 @@
 #include "mesh/deformation_file.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/simulate.h"
+#include "pipeline/timelapse.h"
 #include "pipeline/warp_stage.h"
 #include "report/report_html.h"
 #include "roles/role_png.h"
@@ -33,7 +36,7 @@ const char* const kRunFiles[] = {"report.html",       "metrics.json",           
                                  "mesh_initial.vtu",  "mesh_deformed.vtu",      "deformation.bin",
                                  "convergence.csv",   "convergence.svg",        "pressure_volume.csv",
                                  "pressure_volume.svg", "scene_used.json",      "roles.png"};
-const char* const kRunFolders[] = {"views", "flythrough"};
+const char* const kRunFolders[] = {"views", "flythrough", "timelapse"};
 
 void prepare_folder(const RunOptions& o) {
   const fs::path out(o.out_dir);
@@ -91,17 +94,36 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   } else if (o.resume) {
     log::info("no checkpoint in " + o.out_dir + ": starting from rest");
   }
-  if (scene.solver.checkpoint_every_steps > 0) {
-    hooks.snapshot_every_steps = scene.solver.checkpoint_every_steps;
+  // One observer for checkpoints and the inflation preview, each on its own period.
+  const int64_t every_checkpoint = scene.solver.checkpoint_every_steps;
+  const int64_t every_frame = o.timelapse_every_steps >= 0 ? o.timelapse_every_steps : scene.output.timelapse_every_steps;
+  std::unique_ptr<Timelapse> timelapse;
+  if (every_frame > 0) timelapse = std::make_unique<Timelapse>(scene, sim, o.out_dir, o.backend);
+  int64_t next_checkpoint = every_checkpoint, next_frame = 0;
+  if (every_checkpoint > 0 || every_frame > 0) {
+    hooks.snapshot_every_steps = std::min(every_checkpoint > 0 ? every_checkpoint : INT64_MAX,
+                                          every_frame > 0 ? every_frame : INT64_MAX);
     hooks.on_snapshot = [&](const SolverSnapshot& s) {
-      Deformation d;
-      d.displacement_m = displacements(sim.mesh, s.x);
-      d.pressure_pa = s.pressure_pa;
-      write_deformation(checkpoint, sim.mesh, d);
+      if (every_checkpoint > 0 && s.step >= next_checkpoint) {
+        Deformation d;
+        d.displacement_m = displacements(sim.mesh, s.x);
+        d.pressure_pa = s.pressure_pa;
+        write_deformation(checkpoint, sim.mesh, d);
+        next_checkpoint = (s.step / every_checkpoint + 1) * every_checkpoint;
+      }
+      if (timelapse && s.step >= next_frame) {
+        timelapse->frame(s);
+        next_frame = (s.step / every_frame + 1) * every_frame;
+      }
     };
   }
   write_roles_png(sim.roles, (out / "roles.png").string());
   solve_simulation(scene, sim, hooks);
+  if (timelapse) {
+    timelapse->frame(SolverSnapshot{sim.result.steps, 0.0, sim.result.final_pressure_pa, sim.result.x});
+    log::info("inflation preview: " + std::to_string(timelapse->finish()) + " frames in " +
+              (out / "timelapse").string());
+  }
   write_simulation(scene, sim, o.out_dir);
   std::error_code ec;
   fs::remove(checkpoint, ec);   // the finished solve's shape is deformation.bin now

@@ -21,6 +21,7 @@ struct RunOptions {
   std::string out_dir;
   bool force = false;    // replace the outputs of an earlier run
   bool resume = false;   // continue from out_dir/checkpoint.bin when there is one
+  int64_t timelapse_every_steps = -1;   // the inflation preview; -1: the scene's output.timelapse_every_steps
   GlBackend backend = GlBackend::Auto;
 };
 

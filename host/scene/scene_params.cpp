@@ -322,7 +322,8 @@ const Table<SceneOutput>& output_table() {
       {"write_slices", &SceneOutput::write_slices, "", any(), "Write before/after slice pairs (axial, coronal, sagittal)."},
       {"write_depth", &SceneOutput::write_depth, "", any(), "Write a depth map beside each view."},
       {"timelapse_every_steps", &SceneOutput::timelapse_every_steps, "", in(0, 1e9),
-       "Write the deformed mesh every this many solver steps; 0 = never."},
+       "Inflation preview of `pneumo run`: warp and render the first view and the exterior views every this many "
+       "solver steps into timelapse/ (MP4 with ffmpeg); 0 = never."},
   };
   return t;
 }

@@ -1,0 +1,93 @@
+#include "pipeline/timelapse.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "core/log.h"
+#include "core/units.h"
+#include "io/volume_io.h"
+#include "pipeline/render_scene.h"
+#include "warp/point_map.h"
+#include "warp/warp.h"
+#include "warp/warp_mesh.h"
+
+namespace pneumo {
+
+namespace fs = std::filesystem;
+
+Timelapse::Timelapse(const Scene& scene, const Simulation& sim, const std::string& out_dir, GlBackend backend)
+    : scene_(scene), preview_(scene), sim_(sim), out_dir_(out_dir), backend_(backend),
+      ct_(read_volume(scene.require_ct())) {
+  if (!scene.inputs.labels.empty()) labels_ = std::make_unique<Volume>(read_volume(scene.inputs.labels));
+  SceneRender& r = preview_.render;
+  r.paths.clear();
+  if (!r.cameras.empty()) {
+    r.cameras.resize(1);
+    r.ports.clear();
+  } else if (!r.ports.empty()) {
+    r.ports.resize(1);
+  }
+  r.exterior_views = true;
+  preview_.output.write_depth = false;
+  std::error_code ec;
+  fs::remove_all(fs::path(out_dir_) / "timelapse", ec);
+}
+
+void Timelapse::frame(const SolverSnapshot& snapshot) {
+  const Mesh& m = sim_.mesh;
+  std::vector<Vec3> u(m.rest_m.size());
+  for (std::size_t n = 0; n < u.size(); ++n) u[n] = snapshot.x[n] - m.rest_m[n];
+  const WarpMesh wm = make_warp_mesh(m, u);
+  WarpSource src;
+  src.ct_hu = sim_.roles.ct.data<float>();
+  src.labels = labels_ ? sim_.roles.label.data() : nullptr;
+  src.roles = sim_.roles.role.data();
+  WarpBox box;
+  box.lo = sim_.roles.pad.lo;
+  box.dims = ct_.geometry().dims;
+  WarpOptions wo;
+  wo.cavity_label = uint16_t(scene_.output.cavity_label);
+  const WarpResult w = warp_on_device(scene_.device, wm, src, box, wo);
+
+  Volume ct(ct_.geometry(), VoxelType::Float32);
+  std::copy(w.ct_hu.begin(), w.ct_hu.end(), ct.data<float>());
+  std::unique_ptr<Volume> labels;
+  if (labels_) {
+    labels = std::make_unique<Volume>(ct_.geometry(), VoxelType::UInt16);
+    std::copy(w.labels.begin(), w.labels.end(), labels->data<uint16_t>());
+  }
+  const PointMap point_map(wm, sim_.roles.role.data());
+  RenderOptions ro;
+  const fs::path scratch = fs::path(out_dir_) / "timelapse" / ".frame";
+  ro.out_dir = scratch.string();
+  ro.backend = backend_;
+  ro.map_point = [&point_map](const Vec3& p) -> Vec3 { return point_map.to_deformed(p).point_mm; };
+  RenderRun run;
+  run.deformed = true;
+  run.ct_path = "(warped at step " + std::to_string(snapshot.step) + ")";
+  const RenderRun done = render_volumes(preview_, ro, ct, labels.get(), run);
+  ++frames_;
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%04d.png", frames_);
+  for (const std::string& f : done.files) {
+    if (f.rfind("views/", 0) != 0) continue;
+    const std::string view = f.substr(6, f.size() - 10);
+    const fs::path dir = fs::path(out_dir_) / "timelapse" / view;
+    fs::create_directories(dir);
+    fs::rename(scratch / f, dir / name);
+  }
+  std::error_code ec;
+  fs::remove_all(scratch, ec);
+  log::debug("timelapse frame " + std::to_string(frames_) + " at step " + std::to_string(snapshot.step) + ", " +
+             std::to_string(snapshot.pressure_pa / units::kPaPerMmHg) + " mmHg");
+}
+
+int Timelapse::finish() {
+  const fs::path root = fs::path(out_dir_) / "timelapse";
+  if (frames_ > 1 && ffmpeg_available() && fs::exists(root))
+    for (const auto& e : fs::directory_iterator(root))
+      if (e.is_directory()) encode_mp4(e.path(), root / (e.path().filename().string() + ".mp4"));
+  return frames_;
+}
+
+}  // namespace pneumo
