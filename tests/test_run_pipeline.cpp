@@ -207,3 +207,16 @@ TEST(RunPipeline, RealCtEndToEnd) {
   std::printf("real CT run: rise %.1f mm, cavity %.0f ml, %.1f s\n", m.at("anterior_rise_mm").get<double>(),
               m.at("cavity_volume_ml").get<double>(), m.at("stage_seconds").at("total").get<double>());
 }
+
+TEST(RunPipeline, RenderAfterSimulateAndWarpUsesTheWarpsPointMapping) {
+  // Compared: `pneumo render` run by hand after `simulate` and `warp` into one folder against `pneumo run`:
+  // the ports must travel with the skin (render.json's point_mapping "warp", not the identity).
+  ScratchDir dir;
+  small_phantom(dir);
+  const std::string scene = dir.file("scene.json"), out = dir.file("case");
+  for (const char* sub : {"simulate", "warp", "render"}) {
+    const auto r = testing_support::run_pneumo(std::string("-q ") + sub + " " + scene + " --out " + out);
+    ASSERT_EQ(r.code, 0) << sub << ": " << r.err;
+  }
+  EXPECT_EQ(read_json(fs::path(out) / "render.json").at("point_mapping").get<std::string>(), "warp");
+}

@@ -1,9 +1,11 @@
 #include <filesystem>
+#include <memory>
 
 #include "cli/commands.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "pipeline/render_scene.h"
+#include "pipeline/warp_stage.h"
 
 namespace pneumo::cli {
 
@@ -28,6 +30,16 @@ Run add_render(CLI::App& app) {
     std::filesystem::create_directories(o->out, ec);
     if (ec) throw InputError(o->out + ": cannot create the output folder (" + ec.message() + ")");
     check_writable_target((std::filesystem::path(o->out) / "render.json").string());
+    // After simulate and warp into the same folder, ports travel with the skin through the solved shape.
+    std::unique_ptr<DeformedMesh> deformed;
+    std::unique_ptr<PointMap> point_map;
+    if (std::filesystem::exists(std::filesystem::path(o->out) / "deformed_ct.nii.gz") &&
+        std::filesystem::exists(std::filesystem::path(o->out) / "deformation.bin")) {
+      deformed = std::make_unique<DeformedMesh>(load_deformed_mesh(scene, o->out));
+      point_map = std::make_unique<PointMap>(deformed->point_map());
+      const PointMap* pm = point_map.get();
+      opt.map_point = [pm](const Vec3& p) -> Vec3 { return pm->to_deformed(p).point_mm; };
+    }
     const RenderRun run = render_scene(scene, opt);
     const auto& rj = run.report["render"];
     std::printf("render: %d views and %d fly-through frames from %s (%s%s); results in %s\n", run.views, run.frames,

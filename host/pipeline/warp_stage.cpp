@@ -63,6 +63,15 @@ void fill_rounded(Volume& v, const std::vector<float>& hu) {
 
 }  // namespace
 
+DeformedMesh load_deformed_mesh(const Scene& scene, const std::string& sim_dir) {
+  DeformedMesh d;
+  d.roles = load_roles(scene);
+  d.mesh = build_scene_mesh(VoxelRoles{d.roles.geometry, d.roles.role.data(), d.roles.label.data()}, scene);
+  d.deformation = read_deformation(in_dir(sim_dir, "deformation.bin"), d.mesh);
+  d.warp_mesh = make_warp_mesh(d.mesh, d.deformation.displacement_m);
+  return d;
+}
+
 WarpedCase warp_scene(const Scene& scene, const std::string& sim_dir) {
   read_metrics(sim_dir);   // a finished simulation, before reading a large CT for nothing
   WarpedCase w;

@@ -37,6 +37,18 @@ struct WarpedCase {
   PointMap point_map() const { return PointMap(warp_mesh, roles.role.data()); }
 };
 
+/// A finished simulation's deformation as a point mapping, without warping images: roles and mesh
+/// rebuilt from the scene, DIR/deformation.bin read (and checked against the mesh).
+struct DeformedMesh {
+  RoleVolume roles;
+  Mesh mesh;
+  Deformation deformation;
+  WarpMesh warp_mesh;
+  /// Keep this object alive while using the map.
+  PointMap point_map() const { return PointMap(warp_mesh, roles.role.data()); }
+};
+DeformedMesh load_deformed_mesh(const Scene& scene, const std::string& sim_dir);
+
 /// Everything but the writing. `sim_dir` holds a finished simulation of this scene (metrics.json
 /// and deformation.bin); InputError naming the file otherwise, or when the label map already uses
 /// output.cavity_label.
