@@ -75,7 +75,7 @@ LabelColours default_label_colours();
 /// trilinear footprint and nearest voxel lie in the block that contains it). A block is empty,
 /// and rays may jump over it, when the transfer function gives opacity 0 to every HU between the
 /// minimum and maximum of its voxels, or when `hide_exterior` and all its voxels are exterior air.
-inline constexpr int kOccupancyBlock = 8;
+inline constexpr int kOccupancyBlock = 4;  // 4 beat 8 and 16 on llvmpipe (bench/results/2026-11-23-render.md)
 struct OccupancyGrid {
   Index3 blocks{0, 0, 0};
   std::vector<uint8_t> occupied;  // 1 = may hold something visible

@@ -112,14 +112,19 @@ void main() {
     if (t > t_hi) break;
     if (t < t_lo) continue;
     vec3 p = o + t * d;
-    // Empty-space skipping: jump to the first sample at or beyond this block's far face.
+    // Empty-space skipping, in a loop of its own so that a jump costs only the occupancy fetch:
+    // jump to the first sample at or beyond the far face of each empty block.
     ivec3 b = clamp(ivec3(p / u_block), ivec3(0), u_blocks - 1);  // p ≥ 0: truncation is floor
-    if (texelFetch(u_occupancy, b, 0).r == 0u) {
+    while (texelFetch(u_occupancy, b, 0).r == 0u) {
       vec3 te = (vec3(b) * u_block + far_face - o) * inv_d;
       float t_exit = min(min(te.x, te.y), te.z);
-      k = max(k, int(ceil((t_exit - u_near) / u_step - j)) - 1);  // the loop's ++k lands on it
-      continue;
+      k = max(k + 1, int(ceil((t_exit - u_near) / u_step - j)));
+      t = u_near + (float(k) + j) * u_step;
+      if (t > t_hi) break;
+      p = o + t * d;
+      b = clamp(ivec3(p / u_block), ivec3(0), u_blocks - 1);
     }
+    if (t > t_hi) break;
 #if defined(LABELS) || defined(HIDE_EXTERIOR)
     uint id = label_at(p);
 #endif
