@@ -31,6 +31,7 @@ namespace pneumo::gl {
   X(TexImage2D, PFNGLTEXIMAGE2DPROC)                                      \
   X(TexImage3D, PFNGLTEXIMAGE3DPROC)                                      \
   X(TexSubImage3D, PFNGLTEXSUBIMAGE3DPROC)                                \
+  X(GetTexImage, PFNGLGETTEXIMAGEPROC)                                    \
   X(TexParameteri, PFNGLTEXPARAMETERIPROC)                                \
   X(GenFramebuffers, PFNGLGENFRAMEBUFFERSPROC)                            \
   X(DeleteFramebuffers, PFNGLDELETEFRAMEBUFFERSPROC)                      \

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include "core/error.h"
@@ -37,9 +38,10 @@ std::string occupancy_key(const RenderSettings& s) {
 
 struct GlRayCaster::Impl {
   GlContext& ctx;
-  gl::ShaderProgram program;
+  std::map<std::string, std::unique_ptr<gl::ShaderProgram>> programs;  // by variant (#defines)
   GLuint vao = 0, fbo = 0, colour_tex = 0, depth_tex = 0;
-  GLuint hu_tex = 0, label_tex = 0, occ_tex = 0, tf_tex = 0, label_rgba_tex = 0;
+  GLuint hu_tex = 0, grad_tex = 0, label_tex = 0, occ_tex = 0, tf_tex = 0, label_rgba_tex = 0;
+  bool packed = false;  // hu_tex holds (HU, gradient); grad_tex unused
   int fb_width = 0, fb_height = 0;
   bool have_volume = false;
   Geometry geometry;
@@ -49,7 +51,8 @@ struct GlRayCaster::Impl {
   BlockRanges ranges;
   std::string occ_key;
 
-  explicit Impl(GlContext& c) : ctx((c.make_current(), c)), program("fullscreen.vert", "raycast.frag") {
+  explicit Impl(GlContext& c) : ctx((c.make_current(), c)) {
+    program(true, true, false);  // compile the common variant now: shader errors surface here
     const gl::Api& g = gl::api();
     g.GenVertexArrays(1, &vao);
     g.GenFramebuffers(1, &fbo);
@@ -58,11 +61,23 @@ struct GlRayCaster::Impl {
 
   ~Impl() {
     const gl::Api& g = gl::api();
-    GLuint tex[] = {colour_tex, depth_tex, hu_tex, label_tex, occ_tex, tf_tex, label_rgba_tex};
+    GLuint tex[] = {colour_tex, depth_tex, hu_tex, grad_tex, label_tex, occ_tex, tf_tex, label_rgba_tex};
     for (GLuint t : tex)
       if (t) g.DeleteTextures(1, &t);
     if (fbo) g.DeleteFramebuffers(1, &fbo);
     if (vao) g.DeleteVertexArrays(1, &vao);
+  }
+
+  gl::ShaderProgram& program(bool packed_volume, bool labels, bool hide_exterior) {
+    std::vector<std::string> defines;
+    if (packed_volume) defines.push_back("PACKED");
+    if (labels) defines.push_back("LABELS");
+    if (hide_exterior) defines.push_back("HIDE_EXTERIOR");
+    std::string key;
+    for (const auto& d : defines) key += d + ";";
+    auto& p = programs[key];
+    if (!p) p = std::make_unique<gl::ShaderProgram>("fullscreen.vert", "raycast.frag", defines);
+    return *p;
   }
 
   void ensure_framebuffer(int w, int h) {
@@ -117,20 +132,25 @@ void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
     if (d[a] > max3d)
       throw InputError("the volume's " + std::to_string(d[a]) + " voxels along axis " + std::to_string(a) +
                        " exceed this OpenGL's 3-D texture limit of " + std::to_string(max3d));
-  g.PixelStorei(GL_UNPACK_ALIGNMENT, 1);  // R16 rows need not be 4-byte aligned
+  g.PixelStorei(GL_UNPACK_ALIGNMENT, 1);  // 16-bit rows need not be 4-byte aligned
   if (m.hu_tex) g.DeleteTextures(1, &m.hu_tex);
+  if (m.grad_tex) g.DeleteTextures(1, &m.grad_tex);
+  m.grad_tex = 0;
   m.hu_tex = make_texture(GL_TEXTURE_3D, GL_LINEAR);
-  if (v.hu_is_int16 && !force_float) {
-    std::vector<int16_t> h(v.hu.size());
-    for (std::size_t n = 0; n < h.size(); ++n) h[n] = static_cast<int16_t>(v.hu[n]);
-    // SNORM maps s to s/32767 exactly for s in ±32767 and filters in floating point.
-    g.TexImage3D(GL_TEXTURE_3D, 0, GL_R16_SNORM, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RED, GL_SHORT,
-                 h.data());
+  // SNORM maps s to s/32767 exactly for s in ±32767 and filters in floating point.
+  m.packed = v.hu_is_int16 && !force_float;
+  const std::vector<int16_t> grad = voxel_gradients(v, m.packed);
+  if (m.packed) {  // (HU, gx, gy, gz): one fetch per shaded sample
+    g.TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA16_SNORM, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RGBA,
+                 GL_SHORT, grad.data());
     m.hu_scale = 32767.0f;
-    m.hu_format = "r16_snorm";
+    m.hu_format = "rgba16_snorm";
   } else {
     g.TexImage3D(GL_TEXTURE_3D, 0, GL_R32F, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RED, GL_FLOAT,
                  v.hu.data());
+    m.grad_tex = make_texture(GL_TEXTURE_3D, GL_LINEAR);
+    g.TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA16_SNORM, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RGBA,
+                 GL_SHORT, grad.data());
     m.hu_scale = 1.0f;
     m.hu_format = "r32f";
   }
@@ -154,6 +174,23 @@ void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
              std::to_string(d[2]) + " as " + m.hu_format);
 }
 
+std::vector<int16_t> GlRayCaster::read_gradient_texture() {
+  Impl& m = *impl_;
+  if (!m.have_volume) throw std::logic_error("GlRayCaster::read_gradient_texture before set_volume");
+  m.ctx.make_current();
+  const gl::Api& g = gl::api();
+  std::vector<int16_t> t(std::size_t(m.geometry.voxel_count()) * 4);
+  g.BindTexture(GL_TEXTURE_3D, m.packed ? m.hu_tex : m.grad_tex);
+  g.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  g.GetTexImage(GL_TEXTURE_3D, 0, GL_RGBA, GL_SHORT, t.data());
+  gl::check_error("gradient texture read back");
+  std::vector<int16_t> out(std::size_t(m.geometry.voxel_count()) * 3);
+  const int first = m.packed ? 1 : 0;
+  for (std::size_t n = 0; n < out.size() / 3; ++n)
+    for (int c = 0; c < 3; ++c) out[3 * n + c] = t[4 * n + first + c];
+  return out;
+}
+
 RenderImage GlRayCaster::render(const ViewCamera& cam, const RenderSettings& s) {
   Impl& m = *impl_;
   if (!m.have_volume) throw std::logic_error("GlRayCaster::render before set_volume");
@@ -166,7 +203,10 @@ RenderImage GlRayCaster::render(const ViewCamera& cam, const RenderSettings& s) 
   // Transfer function and label colour tables (small; uploaded every frame).
   if (!m.tf_tex) m.tf_tex = make_texture(GL_TEXTURE_2D, GL_LINEAR);
   g.BindTexture(GL_TEXTURE_2D, m.tf_tex);
-  const std::vector<float> tf = s.tf.table_rgba(kTfTableHuMin, kTfTableSize);
+  std::vector<float> tf = s.tf.table_rgba(kTfTableHuMin, kTfTableSize);
+  const double exponent = s.step_mm / kOpacityUnitMm;  // opacity correction, tabulated (model step 2)
+  for (std::size_t i = 3; i < tf.size(); i += 4)
+    tf[i] = float(1.0 - std::pow(1.0 - std::min(double(tf[i]), 1.0), exponent));
   g.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, kTfTableSize, 1, 0, GL_RGBA, GL_FLOAT, tf.data());
   if (!m.label_rgba_tex) m.label_rgba_tex = make_texture(GL_TEXTURE_2D, GL_NEAREST);
   g.BindTexture(GL_TEXTURE_2D, m.label_rgba_tex);
@@ -174,30 +214,34 @@ RenderImage GlRayCaster::render(const ViewCamera& cam, const RenderSettings& s) 
   g.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 256, 256, 0, GL_RGBA, GL_UNSIGNED_BYTE, s.label_colours.rgba.data());
   gl::check_error("tables upload");
 
-  m.program.use();
-  const GLuint textures[] = {m.hu_tex, m.label_tex, m.occ_tex, m.tf_tex, m.label_rgba_tex};
-  const GLenum targets[] = {GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_2D, GL_TEXTURE_2D};
-  const char* names[] = {"u_hu", "u_labels", "u_occupancy", "u_tf", "u_label_rgba"};
-  for (int i = 0; i < 5; ++i) {
+  const gl::ShaderProgram& prog = m.program(m.packed, s.show_labels, s.hide_exterior_air);
+  prog.use();
+  const GLuint textures[] = {m.hu_tex, m.grad_tex, m.label_tex, m.occ_tex, m.tf_tex, m.label_rgba_tex};
+  const GLenum targets[] = {GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_2D, GL_TEXTURE_2D};
+  const char* names[] = {"u_vol", "u_grad", "u_labels", "u_occupancy", "u_tf", "u_label_rgba"};
+  for (int i = 0; i < 6; ++i) {
+    if (!textures[i]) continue;
     g.ActiveTexture(GL_TEXTURE0 + i);
     g.BindTexture(targets[i], textures[i]);
-    g.Uniform1i(m.program.uniform(names[i]), i);
+    g.Uniform1i(prog.uniform(names[i]), i);
   }
   g.ActiveTexture(GL_TEXTURE0);
-  auto u3 = [&](const char* n, const Vec3& v) { g.Uniform3f(m.program.uniform(n), float(v.x()), float(v.y()), float(v.z())); };
-  auto u1 = [&](const char* n, double v) { g.Uniform1f(m.program.uniform(n), float(v)); };
-  auto i1 = [&](const char* n, int v) { g.Uniform1i(m.program.uniform(n), v); };
+  auto u3 = [&](const char* n, const Vec3& v) { g.Uniform3f(prog.uniform(n), float(v.x()), float(v.y()), float(v.z())); };
+  auto u1 = [&](const char* n, double v) { g.Uniform1f(prog.uniform(n), float(v)); };
+  auto i1 = [&](const char* n, int v) { g.Uniform1i(prog.uniform(n), v); };
   const auto& d = m.geometry.dims;
-  u3("u_dims", Vec3(double(d[0]), double(d[1]), double(d[2])));
+  u3("u_inv_dims", Vec3(1.0 / double(d[0]), 1.0 / double(d[1]), 1.0 / double(d[2])));
+  g.Uniform3i(prog.uniform("u_dims_i"), GLint(d[0]), GLint(d[1]), GLint(d[2]));
   float w2i[9];
   for (int c = 0; c < 3; ++c)
     for (int r = 0; r < 3; ++r) w2i[3 * c + r] = float(m.w2i(r, c));  // column-major
-  g.UniformMatrix3fv(m.program.uniform("u_world_to_index"), 1, GL_FALSE, w2i);
+  g.UniformMatrix3fv(prog.uniform("u_world_to_index"), 1, GL_FALSE, w2i);
   u3("u_origin_mm", m.geometry.origin_mm);
   u1("u_hu_scale", m.hu_scale);
+  u1("u_grad_scale", 32767.0 * kGradientHalf);
   u1("u_tf_hu_min", kTfTableHuMin);
   u1("u_tf_size", kTfTableSize);
-  g.Uniform3i(m.program.uniform("u_blocks"), GLint(m.ranges.blocks[0]), GLint(m.ranges.blocks[1]),
+  g.Uniform3i(prog.uniform("u_blocks"), GLint(m.ranges.blocks[0]), GLint(m.ranges.blocks[1]),
               GLint(m.ranges.blocks[2]));
   u1("u_block", kOccupancyBlock);
   u3("u_cam_pos", cam.position_mm);
@@ -207,14 +251,11 @@ RenderImage GlRayCaster::render(const ViewCamera& cam, const RenderSettings& s) 
   i1("u_fisheye", cam.lens == Lens::Fisheye ? 1 : 0);
   u1("u_half_fov", cam.fov_deg * 3.14159265358979323846 / 360.0);
   u1("u_near", cam.near_mm);
-  g.Uniform2f(m.program.uniform("u_image"), float(cam.width), float(cam.height));
+  g.Uniform2f(prog.uniform("u_image"), float(cam.width), float(cam.height));
   u1("u_step", s.step_mm);
-  u1("u_opacity_exp", s.step_mm / kOpacityUnitMm);
   i1("u_jitter", s.jitter ? 1 : 0);
-  g.Uniform1ui(m.program.uniform("u_seed"), s.jitter_seed);
-  i1("u_show_labels", s.show_labels ? 1 : 0);
+  g.Uniform1ui(prog.uniform("u_seed"), s.jitter_seed);
   u1("u_label_opacity", s.label_opacity);
-  i1("u_hide_exterior", s.hide_exterior_air ? 1 : 0);
   u1("u_ambient", s.ambient);
   u1("u_diffuse", s.diffuse);
   u1("u_specular", s.specular);

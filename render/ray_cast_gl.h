@@ -4,6 +4,7 @@
 // a framebuffer object (RGBA32F colour + R32F depth) and reads the image back.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "render/camera_model.h"
 #include "render/gl_context.h"
@@ -19,16 +20,21 @@ class GlRayCaster {
   GlRayCaster(const GlRayCaster&) = delete;
   GlRayCaster& operator=(const GlRayCaster&) = delete;
 
-  /// Uploads the volume. HU go into a 16-bit texture (R16_SNORM, exact for integer HU) when they
-  /// are integers within ±32767 and `force_float` is off, else a 32-bit float texture.
+  /// Uploads the volume with its shading gradients (voxel_gradients(), computed here once per
+  /// volume). When the HU are integers within ±32767 and `force_float` is off, HU and gradient
+  /// share one RGBA16_SNORM texture (exact: a shaded sample is one fetch); else the HU go into a
+  /// 32-bit float texture and the gradient into an RGBA16_SNORM one.
   /// InputError when a dimension exceeds the driver's GL_MAX_3D_TEXTURE_SIZE.
   void set_volume(const RenderVolume& volume, bool force_float = false);
 
   /// Renders one view (blocks until the image is read back).
   RenderImage render(const ViewCamera& camera, const RenderSettings& settings);
 
-  /// "r16_snorm" or "r32f": how the HU were uploaded.
+  /// "rgba16_snorm" (HU with the gradient) or "r32f": how the HU were uploaded.
   const std::string& hu_format() const;
+
+  /// The gradient texture read back (3 int16 per voxel, i fastest), for tests.
+  std::vector<int16_t> read_gradient_texture();
 
   struct Impl;
 

@@ -32,6 +32,27 @@ struct Sampler {
     return (c00 * (1 - fy) + c10 * fy) * (1 - fz) + (c01 * (1 - fy) + c11 * fy) * fz;
   }
 
+  // Trilinear interpolation of the per-voxel gradients (voxel_gradient(), HU per voxel index) at a
+  // continuous index, clamped like hu().
+  Vec3 gradient(const Vec3& p) const {
+    const double x = std::clamp(p.x(), 0.0, double(nx - 1));
+    const double y = std::clamp(p.y(), 0.0, double(ny - 1));
+    const double z = std::clamp(p.z(), 0.0, double(nz - 1));
+    const int64_t i = std::min<int64_t>(int64_t(x), nx - 1), j = std::min<int64_t>(int64_t(y), ny - 1),
+                  k = std::min<int64_t>(int64_t(z), nz - 1);
+    const int64_t i1 = std::min(i + 1, nx - 1), j1 = std::min(j + 1, ny - 1), k1 = std::min(k + 1, nz - 1);
+    const double fx = x - i, fy = y - j, fz = z - k;
+    auto g = [&](int64_t a, int64_t b, int64_t c) {
+      const auto q = voxel_gradient(v, a, b, c);
+      return Vec3(q[0], q[1], q[2]);
+    };
+    const Vec3 c00 = g(i, j, k) * (1 - fx) + g(i1, j, k) * fx;
+    const Vec3 c10 = g(i, j1, k) * (1 - fx) + g(i1, j1, k) * fx;
+    const Vec3 c01 = g(i, j, k1) * (1 - fx) + g(i1, j, k1) * fx;
+    const Vec3 c11 = g(i, j1, k1) * (1 - fx) + g(i1, j1, k1) * fx;
+    return kGradientHalf * ((c00 * (1 - fy) + c10 * fy) * (1 - fz) + (c01 * (1 - fy) + c11 * fy) * fz);
+  }
+
   uint16_t label(const Vec3& p) const {
     if (v.labels.empty()) return 0;
     const int64_t i = std::clamp<int64_t>(int64_t(std::floor(p.x() + 0.5)), 0, nx - 1);
@@ -103,10 +124,7 @@ RenderImage render_reference(const RenderVolume& volume, const ViewCamera& cam, 
           const double w = s.label_opacity * lc[3] / 255.0;
           c = (1.0 - w) * c + w * Vec3(lc[0], lc[1], lc[2]) / 255.0;
         }
-        const Vec3 g_idx(0.5 * (smp.hu(p + Vec3(1, 0, 0)) - smp.hu(p - Vec3(1, 0, 0))),
-                         0.5 * (smp.hu(p + Vec3(0, 1, 0)) - smp.hu(p - Vec3(0, 1, 0))),
-                         0.5 * (smp.hu(p + Vec3(0, 0, 1)) - smp.hu(p - Vec3(0, 0, 1))));
-        const Vec3 g = w2i_t * g_idx;
+        const Vec3 g = w2i_t * smp.gradient(p);
         double diffuse = 1.0, specular = 0.0;
         if (g.norm() >= kFlatGradient) {
           const double ndl = std::abs(g.normalized().dot(*dir));

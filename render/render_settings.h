@@ -7,12 +7,16 @@
 //    the k with t_k inside the clipped interval; j = 0, or with jitter a per-pixel hash in [0, 1)
 //    (jitter_offset(), the same bits on both sides, so jittered images still compare).
 // 2. Sample: HU by trilinear interpolation; colour c and opacity α from the transfer function;
-//    opacity corrected for the step: α′ = 1 − (1 − α)^(Δs / 1 mm). With hide_exterior_air, a
+//    opacity corrected for the step: α′ = 1 − (1 − α)^(Δs / 1 mm). (The GL path tabulates c and
+//    the corrected α′ at every integer HU and interpolates the table linearly; the reference
+//    evaluates the piecewise-linear function and the correction at the sample's HU.) With hide_exterior_air, a
 //    sample whose nearest voxel is labelled kExteriorAirLabel contributes nothing (exterior views).
 // 3. Labels: the nearest voxel's id picks an RGBA colour; c ← mix(c, label rgb, label_opacity·a).
-// 4. Shading (Phong with a headlight at the tip): gradient g by central differences of the
-//    trilinear HU one voxel either side along each index axis, taken to world (g_w = M⁻ᵀ g with
-//    M = direction·spacing); n = g_w/|g_w|; light and view both along −dir, so
+// 4. Shading (Phong with a headlight at the tip): gradient g (HU per voxel index) by trilinear
+//    interpolation, at the sample, of per-voxel central differences pre-computed once per volume
+//    (voxel_gradient() in render_volume.h: (h[i+1] − h[i−1])/2 per index axis, the difference
+//    rounded to an integer and clamped to ±32767 so it is exact in 16 bits), taken to world
+//    (g_w = M⁻ᵀ g with M = direction·spacing); n = g_w/|g_w|; light and view both along −dir, so
 //    diffuse = |n·dir|, specular = |n·dir|^shininess (two-sided). Headlight attenuation at the
 //    sample's distance t: a = 1/(1 + (t/d0)²). Shaded colour = c·(ambient + diffuse_k·diffuse·a)
 //    + specular_k·specular·a (white highlights). Where |g_w| < 1e-3 HU/mm (no surface), diffuse = 1

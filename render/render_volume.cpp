@@ -59,6 +59,26 @@ void RenderVolume::mark_exterior_air(double threshold_hu) {
   }
 }
 
+std::vector<int16_t> voxel_gradients(const RenderVolume& v, bool with_hu) {
+  const auto& d = v.geometry.dims;
+  std::vector<int16_t> out(std::size_t(v.geometry.voxel_count()) * 4);
+#pragma omp parallel for schedule(static)
+  for (int64_t k = 0; k < d[2]; ++k)
+    for (int64_t j = 0; j < d[1]; ++j)
+      for (int64_t i = 0; i < d[0]; ++i) {
+        const int64_t n = i + d[0] * (j + d[1] * k);
+        const auto g = voxel_gradient(v, i, j, k);
+        int16_t* o = &out[std::size_t(4 * n)];
+        if (with_hu) {
+          o[0] = int16_t(v.hu[n]);
+          o[1] = g[0], o[2] = g[1], o[3] = g[2];
+        } else {
+          o[0] = g[0], o[1] = g[1], o[2] = g[2], o[3] = 0;
+        }
+      }
+  return out;
+}
+
 Mat3 RenderVolume::world_to_index() const {
   return (geometry.direction * geometry.spacing_mm.asDiagonal()).inverse();
 }

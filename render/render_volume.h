@@ -1,7 +1,9 @@
 #pragma once
 // What the ray casters read: the CT in HU on its grid, an optional label map on the same grid, and
 // the coarse occupancy grid that lets the GL path skip empty space.
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -34,6 +36,31 @@ struct RenderVolume {
   bool contains(const Vec3& world_mm) const;
 };
 
+/// Shading gradients (render_settings.h, model step 4), one per voxel, computed once per volume:
+/// along each index axis the central difference of the voxel HU, h[i+1] − h[i−1] with indices
+/// clamped to the grid, rounded to the nearest integer (ties to even) and clamped to ±32767, so
+/// that it fits a 16-bit texture exactly. The gradient in HU per voxel index is half the stored
+/// value (kGradientHalf); samples between voxels interpolate it trilinearly like the HU. Both ray
+/// casters read these same numbers: the GL path from a texture built with voxel_gradients(), the
+/// CPU reference by calling voxel_gradient() at the eight corners of each sample.
+inline constexpr double kGradientHalf = 0.5;
+inline constexpr int kGradientMax = 32767;
+inline std::array<int16_t, 3> voxel_gradient(const RenderVolume& v, int64_t i, int64_t j, int64_t k) {
+  const int64_t nx = v.geometry.dims[0], ny = v.geometry.dims[1], nz = v.geometry.dims[2];
+  auto h = [&](int64_t a, int64_t b, int64_t c) { return double(v.hu[a + nx * (b + ny * c)]); };
+  auto q = [](double diff) {
+    return int16_t(std::clamp(std::nearbyint(diff), -double(kGradientMax), double(kGradientMax)));
+  };
+  return {q(h(std::min(i + 1, nx - 1), j, k) - h(std::max<int64_t>(i - 1, 0), j, k)),
+          q(h(i, std::min(j + 1, ny - 1), k) - h(i, std::max<int64_t>(j - 1, 0), k)),
+          q(h(i, j, std::min(k + 1, nz - 1)) - h(i, j, std::max<int64_t>(k - 1, 0)))};
+}
+
+/// The texture the GL path samples, 4 int16 per voxel (i fastest), OpenMP over slices: with
+/// `with_hu` (integer HU, hu_is_int16) (HU, gx, gy, gz), else (gx, gy, gz, 0) beside a float HU
+/// texture. gx, gy, gz as voxel_gradient().
+std::vector<int16_t> voxel_gradients(const RenderVolume& v, bool with_hu);
+
 /// Organ colours by label id, blended over the CT colour (method.md §8; Kitasaka Fig. 6: liver dark
 /// red, kidneys yellow, aorta green). 8-bit RGBA per id, alpha 0 = not coloured. Ids 0..65535.
 struct LabelColours {
@@ -48,7 +75,7 @@ LabelColours default_label_colours();
 /// trilinear footprint and nearest voxel lie in the block that contains it). A block is empty,
 /// and rays may jump over it, when the transfer function gives opacity 0 to every HU between the
 /// minimum and maximum of its voxels, or when `hide_exterior` and all its voxels are exterior air.
-inline constexpr int kOccupancyBlock = 8;
+inline constexpr int kOccupancyBlock = 4;  // 4 beat 8 and 16 on llvmpipe (bench/results/2026-11-23-render.md)
 struct OccupancyGrid {
   Index3 blocks{0, 0, 0};
   std::vector<uint8_t> occupied;  // 1 = may hold something visible

@@ -3,20 +3,32 @@
 // a headlight, organ labels. The model is stated in render/render_settings.h; the CPU reference
 // (render/ray_cast_ref.cpp) implements the same model and the tests compare the two.
 #version 330 core
+// Compile-time variants (prepended #defines) instead of uniform branches: llvmpipe runs both
+// sides of every `if` under lane masks and never jumps over a block, so a texture fetch behind a
+// false uniform condition still costs its full price in every loop iteration.
+//   PACKED         u_vol holds (HU, gradient) in one RGBA16_SNORM texture, so a shaded sample is
+//                  one trilinear fetch (integer HU); else u_vol is HU (R32F) and u_grad the gradient
+//   LABELS         organ colours blended (show_labels)
+//   HIDE_EXTERIOR  samples in exterior air contribute nothing (hide_exterior_air)
 
 layout(location = 0) out vec4 out_colour;  // premultiplied RGB over black, accumulated opacity
 layout(location = 1) out float out_depth;  // mm to the first surface, -1 where there is none
 
-uniform sampler3D u_hu;          // HU × u_hu_scale (R16_SNORM: 1/32767; R32F: 1), linear filtering
+uniform sampler3D u_vol;         // PACKED: (HU, gx, gy, gz)/32767 (RGBA16_SNORM); else HU (R32F)
+#ifndef PACKED
+uniform sampler3D u_grad;        // (gx, gy, gz, 0)/32767 (RGBA16_SNORM)
+#endif
 uniform usampler3D u_labels;     // label ids, nearest (texelFetch)
 uniform usampler3D u_occupancy;  // 1 = block may hold something visible
-uniform sampler2D u_tf;          // RGBA per HU, u_tf_size entries from u_tf_hu_min, linear
+uniform sampler2D u_tf;          // RGB and step-corrected opacity per HU, u_tf_size entries from u_tf_hu_min
 uniform sampler2D u_label_rgba;  // 256 × 256: id = x + 256·y, RGBA8
 
-uniform vec3 u_dims;             // voxels per axis
+uniform vec3 u_inv_dims;         // 1 / voxels per axis
+uniform ivec3 u_dims_i;          // voxels per axis
 uniform mat3 u_world_to_index;   // (direction·spacing)⁻¹
 uniform vec3 u_origin_mm;        // world position of voxel (0,0,0)
-uniform float u_hu_scale;
+uniform float u_hu_scale;        // HU per texture unit: 32767 (PACKED) or 1
+uniform float u_grad_scale;      // HU per voxel index per texture unit: 32767 / 2
 uniform float u_tf_hu_min;
 uniform float u_tf_size;
 uniform ivec3 u_blocks;
@@ -29,12 +41,9 @@ uniform float u_near;
 uniform vec2 u_image;            // width, height
 
 uniform float u_step;            // mm
-uniform float u_opacity_exp;     // Δs / 1 mm
 uniform int u_jitter;
 uniform uint u_seed;
-uniform int u_show_labels;
 uniform float u_label_opacity;
-uniform int u_hide_exterior;
 uniform float u_ambient, u_diffuse, u_specular, u_shininess, u_falloff;
 
 const uint kExteriorAir = 65535u;
@@ -42,10 +51,8 @@ const float kEarlyTermination = 0.99;
 const float kDepthOpacity = 0.5;
 const float kFlatGradient = 1e-3;
 
-float hu_at(vec3 idx) { return texture(u_hu, (idx + 0.5) / u_dims).r * u_hu_scale; }
-
 uint label_at(vec3 idx) {
-  ivec3 v = clamp(ivec3(floor(idx + 0.5)), ivec3(0), ivec3(u_dims) - 1);
+  ivec3 v = clamp(ivec3(floor(idx + 0.5)), ivec3(0), u_dims_i - 1);
   return texelFetch(u_labels, v, 0).r;
 }
 
@@ -86,13 +93,18 @@ void main() {
 
   vec3 o = u_world_to_index * (u_cam_pos - u_origin_mm);
   vec3 d = u_world_to_index * dir;  // index units per mm
-  vec2 tc = clip_box(o, d, vec3(0.0), u_dims - 1.0);
+  vec3 dims = vec3(u_dims_i);
+  vec2 tc = clip_box(o, d, vec3(0.0), dims - 1.0);
   float t_lo = max(tc.x, u_near), t_hi = tc.y;
   if (!(t_lo <= t_hi)) return;
   float j = u_jitter != 0 ? jitter_offset(uint(pix.x), uint(pix.y), u_seed) : 0.0;
   int k = max(0, int(ceil((t_lo - u_near) / u_step - j)));
 
+  // Loop invariants of the block jump: the far face of a block along each axis, and 1/d.
+  vec3 inv_d = 1.0 / mix(d, vec3(1e-20), equal(d, vec3(0.0)));
+  vec3 far_face = step(vec3(0.0), d) * u_block;
   mat3 index_to_world_t = transpose(u_world_to_index);
+  float inv_falloff2 = 1.0 / (u_falloff * u_falloff);
   vec3 C = vec3(0.0);
   float A = 0.0;
   for (;; ++k) {
@@ -100,37 +112,48 @@ void main() {
     if (t > t_hi) break;
     if (t < t_lo) continue;
     vec3 p = o + t * d;
-    // Empty-space skipping: jump to the first sample at or beyond this block's far face.
-    ivec3 b = clamp(ivec3(floor(p / u_block)), ivec3(0), u_blocks - 1);
-    if (texelFetch(u_occupancy, b, 0).r == 0u) {
-      vec3 lo = vec3(b) * u_block;
-      float t_exit = clip_box(o, d, lo, lo + u_block).y;
-      k = max(k, int(ceil((t_exit - u_near) / u_step - j)) - 1);  // the loop's ++k lands on it
-      continue;
+    // Empty-space skipping, in a loop of its own so that a jump costs only the occupancy fetch:
+    // jump to the first sample at or beyond the far face of each empty block.
+    ivec3 b = clamp(ivec3(p / u_block), ivec3(0), u_blocks - 1);  // p ≥ 0: truncation is floor
+    while (texelFetch(u_occupancy, b, 0).r == 0u) {
+      vec3 te = (vec3(b) * u_block + far_face - o) * inv_d;
+      float t_exit = min(min(te.x, te.y), te.z);
+      k = max(k + 1, int(ceil((t_exit - u_near) / u_step - j)));
+      t = u_near + (float(k) + j) * u_step;
+      if (t > t_hi) break;
+      p = o + t * d;
+      b = clamp(ivec3(p / u_block), ivec3(0), u_blocks - 1);
     }
-    uint id = (u_show_labels != 0 || u_hide_exterior != 0) ? label_at(p) : 0u;  // a fetch saved otherwise
-    if (u_hide_exterior != 0 && id == kExteriorAir) continue;
-    float h = hu_at(p);
-    vec4 tf = texture(u_tf, vec2((h - u_tf_hu_min + 0.5) / u_tf_size, 0.5));
+    if (t > t_hi) break;
+#if defined(LABELS) || defined(HIDE_EXTERIOR)
+    uint id = label_at(p);
+#endif
+#ifdef HIDE_EXTERIOR
+    if (id == kExteriorAir) continue;
+#endif
+    vec3 tex = (p + 0.5) * u_inv_dims;
+    vec4 v = textureLod(u_vol, tex, 0.0);
+    float h = v.r * u_hu_scale;
+    vec4 tf = textureLod(u_tf, vec2((h - u_tf_hu_min + 0.5) / u_tf_size, 0.5), 0.0);
     if (tf.a <= 0.0) continue;
-    float a = 1.0 - pow(1.0 - min(tf.a, 1.0), u_opacity_exp);
+    float a = tf.a;  // already corrected for the step
     vec3 c = tf.rgb;
-    if (u_show_labels != 0) {
-      vec4 lc = texelFetch(u_label_rgba, ivec2(int(id & 255u), int(id >> 8)), 0);
-      c = mix(c, lc.rgb, u_label_opacity * lc.a);
-    }
-    vec3 g_idx = 0.5 * vec3(hu_at(p + vec3(1, 0, 0)) - hu_at(p - vec3(1, 0, 0)),
-                            hu_at(p + vec3(0, 1, 0)) - hu_at(p - vec3(0, 1, 0)),
-                            hu_at(p + vec3(0, 0, 1)) - hu_at(p - vec3(0, 0, 1)));
+#ifdef LABELS
+    vec4 lc = texelFetch(u_label_rgba, ivec2(int(id & 255u), int(id >> 8)), 0);
+    c = mix(c, lc.rgb, u_label_opacity * lc.a);
+#endif
+#ifdef PACKED
+    vec3 g_idx = v.gba * u_grad_scale;
+#else
+    vec3 g_idx = textureLod(u_grad, tex, 0.0).rgb * u_grad_scale;
+#endif
     vec3 g = index_to_world_t * g_idx;
-    float diffuse = 1.0, specular = 0.0;
-    float glen = length(g);
-    if (glen >= kFlatGradient) {
-      float ndl = abs(dot(g / glen, dir));
-      diffuse = ndl;
-      specular = pow(ndl, u_shininess);
-    }
-    float att = 1.0 / (1.0 + (t / u_falloff) * (t / u_falloff));
+    float glen2 = dot(g, g);
+    bool surface = glen2 >= kFlatGradient * kFlatGradient;
+    float ndl = min(abs(dot(g, dir)) * inversesqrt(max(glen2, 1e-30)), 1.0);
+    float diffuse = surface ? ndl : 1.0;
+    float specular = surface ? pow(ndl, u_shininess) : 0.0;
+    float att = 1.0 / (1.0 + t * t * inv_falloff2);
     vec3 shaded = c * (u_ambient + u_diffuse * diffuse * att) + vec3(u_specular * specular * att);
     C += (1.0 - A) * a * shaded;
     A += (1.0 - A) * a;

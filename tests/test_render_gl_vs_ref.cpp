@@ -94,7 +94,7 @@ TEST_P(RenderGlVsRef, ImagesAgreeByPsnrAndAreNotBlank) {
   }
   GlRayCaster gl(*ctx);
   gl.set_volume(v, k.force_float);
-  EXPECT_EQ(gl.hu_format(), k.force_float ? "r32f" : "r16_snorm");
+  EXPECT_EQ(gl.hu_format(), k.force_float ? "r32f" : "rgba16_snorm");
   Optics o = k.optics;
   const ViewCamera cam = make_view_camera(look_at_pose(k.tip, k.look_at, o.up), o, kSize, kSize);
   const RenderImage g = gl.render(cam, s);
