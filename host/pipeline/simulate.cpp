@@ -12,6 +12,7 @@
 #include "cl/cl_runtime.h"
 #include "mesh/vtu_writer.h"
 #include "report/plot_svg.h"
+#include "solve/solvable.h"
 #include "solve/solver_cl.h"
 
 namespace pneumo {
@@ -40,6 +41,8 @@ Simulation simulate_scene(const Scene& scene) {
      << s.cavity_triangles << " cavity triangles, " << s.fixed_nodes << " fixed nodes, " << s.doubled_cubes
      << " doubled cubes";
   log::info(os.str());
+  const SolveOptions base = solve_options_from_scene(scene);
+  check_solvable(sim.mesh, base, "scene " + scene.path);   // before starting a device: nothing free, or a drift
   if (s.cavity_triangles == 0)
     throw InputError("scene " + scene.path + ": the mesh has no cavity triangles (no wall/viscera interface): the gas "
                      "has nowhere to act; check the role mapping (roles.*_labels) and mesh.model");
@@ -57,7 +60,6 @@ Simulation simulate_scene(const Scene& scene) {
   auto run = [&](const SolveOptions& opt, const std::vector<Vec3>& x_start) {
     return ctx ? solve_opencl(*ctx, sim.mesh, opt, x_start) : solve(sim.mesh, opt, x_start);
   };
-  const SolveOptions base = solve_options_from_scene(scene);
   if (scene.load.pressure_curve_mmhg.empty()) {
     sim.result = run(base, {});
   } else {
