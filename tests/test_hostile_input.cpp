@@ -15,7 +15,6 @@
 #include <functional>
 #include <limits>
 #include <ostream>
-#include <regex>
 #include <set>
 
 #include "cli_test_support.h"
@@ -47,8 +46,12 @@ std::string with_mha_ct(const ScratchDir& d, const std::function<std::string(std
   return scene;
 }
 
+/// The header with the line "KEY = ..." replaced by "KEY = value" (the line must be there).
 std::string replace_line(const std::string& header, const std::string& key, const std::string& value) {
-  return std::regex_replace(header, std::regex("(^|\n)" + key + " = [^\n]*"), "$1" + key + " = " + value);
+  const std::size_t at = header.find(key + " = ");
+  EXPECT_TRUE(at == 0 || (at != std::string::npos && header[at - 1] == '\n')) << key << " not in " << header;
+  if (at == std::string::npos) return header;
+  return header.substr(0, at) + key + " = " + value + header.substr(header.find('\n', at));
 }
 
 /// The tiny case with one CT voxel replaced.
