@@ -288,10 +288,34 @@ TEST(RolesLabels, LabelValuesMustBeIds) {
     const std::string m = message_of([&] { assign_roles(s, ct, bad); });
     EXPECT_NE(m.find(kLabelsName), std::string::npos) << m;
   }
+  // Whole numbers stored as floats are ids. (Ids of each role list present: a list none of whose ids the
+  // map holds is refused, see RolesLabels.AMappingForAnotherLabelMapIsRefused.)
   Volume whole_floats(kTiny, VoxelType::Float32);
+  whole_floats.data<float>()[1] = 1.0f;
+  whole_floats.data<float>()[2] = 2.0f;
   whole_floats.data<float>()[3] = 7.0f;
   const RoleVolume rv = assign_roles(s, ct, &whole_floats);
+  EXPECT_EQ(rv.role[1], Role::Wall);
+  EXPECT_EQ(rv.role[2], Role::Viscera);
   EXPECT_EQ(rv.role[3], Role::Fixed);
+}
+
+TEST(RolesLabels, AMappingForAnotherLabelMapIsRefused) {
+  // Compared: a label map holding ids 0, 1, 2, 3, 7, 9 against scenes whose role lists miss it: a list
+  // with some of its ids present is fine (a mapping for every organ of a segmentation tool, on a CT that
+  // shows a few: the warning names the absent ones); a list with none present is an InputError naming the
+  // label map, the list and the ids the map holds (a mapping written for another tool or id version would
+  // otherwise give every voxel the wrong role in silence).
+  const Volume ct = tiny_ct(), labels = tiny_labels();
+  Scene s = labels_scene();
+  ::testing::internal::CaptureStderr();
+  EXPECT_NO_THROW(assign_roles(s, ct, &labels));   // viscera_labels = {2, 42}: 2 is there
+  ::testing::internal::GetCapturedStderr();
+  s.roles.viscera_labels = {40, 42};
+  const std::string m = message_of([&] { assign_roles(s, ct, &labels); });
+  EXPECT_EQ(m.rfind(std::string(kLabelsName) + ": ", 0), 0u) << m;
+  EXPECT_NE(m.find("roles.viscera_labels (40, 42)"), std::string::npos) << m;
+  EXPECT_NE(m.find("its ids: 1, 2, 3, 7, 9"), std::string::npos) << m;
 }
 
 TEST(RolesLabels, LoadRolesReadsTheScenesFiles) {

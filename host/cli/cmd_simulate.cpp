@@ -23,11 +23,13 @@ Run add_simulate(CLI::App& app) {
     ocl::parse_device_spec(scene.device);   // a bad --device is bad input before any work
     if (std::filesystem::exists(std::filesystem::path(o->out) / "metrics.json") && !o->force)
       throw InputError(o->out + ": already holds a simulation (metrics.json); use --force to overwrite");
+    // Checked now, created only once there are results: a run refused on the way (bad roles, a
+    // diverging solver) leaves nothing behind, not even an empty folder.
+    check_creatable_folder(o->out);
+    const Simulation sim = simulate_scene(scene);
     std::error_code ec;
     std::filesystem::create_directories(o->out, ec);
     if (ec) throw InputError(o->out + ": cannot create the output folder (" + ec.message() + ")");
-    check_writable_target((std::filesystem::path(o->out) / "metrics.json").string());
-    const Simulation sim = simulate_scene(scene);
     write_simulation(scene, sim, o->out);
     const auto m = simulation_metrics(scene, sim);
     std::printf("%s: %s after %lld steps (%s), residual %.2e, anterior rise %.1f mm, cavity %.0f ml, %lld inverted "

@@ -45,6 +45,24 @@ void check_writable_target(const std::string& path) {
   if (::access(dir.c_str(), W_OK) != 0) throw file_error(path, "folder " + dir.string() + " is not writable");
 }
 
+void check_creatable_folder(const std::string& dir) {
+  std::error_code ec;
+  fs::path p = fs::absolute(fs::path(dir), ec);
+  if (ec) throw file_error(dir, "not a usable folder name (" + ec.message() + ")");
+  if (fs::exists(p, ec)) {
+    if (!fs::is_directory(p, ec)) throw file_error(dir, "exists and is not a folder");
+    if (::access(p.c_str(), W_OK) != 0) throw file_error(dir, "the output folder is not writable");
+    return;
+  }
+  fs::path ancestor = p.parent_path();
+  while (!ancestor.empty() && !fs::exists(ancestor, ec) && ancestor != ancestor.root_path())
+    ancestor = ancestor.parent_path();
+  if (!fs::is_directory(ancestor, ec))
+    throw file_error(dir, "cannot create the output folder: " + ancestor.string() + " is not a folder");
+  if (::access(ancestor.c_str(), W_OK) != 0)
+    throw file_error(dir, "cannot create the output folder: " + ancestor.string() + " is not writable");
+}
+
 void write_text_file_atomic(const std::string& path, const std::string& text) {
   check_writable_target(path);
   AtomicFile f(path);

@@ -31,4 +31,9 @@ void write_text_file_atomic(const std::string& path, const std::string& text);
 /// Throws InputError when the folder that would hold `path` does not exist or is not writable.
 void check_writable_target(const std::string& path);
 
+/// Throws InputError when the output folder `dir` could not be written to: it exists and is not a
+/// writable folder, or it does not exist and its nearest existing ancestor is not a writable
+/// folder. Creates nothing, so a run refused later leaves no empty folder behind.
+void check_creatable_folder(const std::string& dir);
+
 }  // namespace pneumo

@@ -154,6 +154,12 @@ nifti_1_header read_checked_header(const std::string& path, bool* swapped) {
   }
   if (h.dim[0] < 1 || h.dim[0] > 7)
     throw file_error(path, "corrupt header: dim[0] = " + std::to_string(h.dim[0]) + " (must be 1..7)");
+  // niftilib prints "** ERROR ... bad dim" to stderr for these before failing: refuse them first, so
+  // the user sees one line.
+  for (int a = 1; a <= h.dim[0]; ++a)
+    if (h.dim[a] < 1)
+      throw file_error(path, "dimension " + std::to_string(a - 1) + " is " + std::to_string(h.dim[a]) +
+                                 " (dim[" + std::to_string(a) + "], must be at least 1)");
   for (int a = 4; a <= h.dim[0]; ++a)
     if (h.dim[a] > 1) {
       std::ostringstream os;

@@ -13,6 +13,7 @@
 #include "mesh/deformation_file.h"
 #include "mesh/vtu_writer.h"
 #include "report/plot_svg.h"
+#include "solve/solvable.h"
 #include "solve/solver_cl.h"
 
 namespace pneumo {
@@ -41,6 +42,8 @@ Simulation prepare_simulation(const Scene& scene) {
      << s.cavity_triangles << " cavity triangles, " << s.fixed_nodes << " fixed nodes, " << s.doubled_cubes
      << " doubled cubes";
   log::info(os.str());
+  // Before starting a device: nothing free, or a part the load would carry away.
+  check_solvable(sim.mesh, solve_options_from_scene(scene), "scene " + scene.path);
   if (s.cavity_triangles == 0)
     throw InputError("scene " + scene.path + ": the mesh has no cavity triangles (no wall/viscera interface): the gas "
                      "has nowhere to act; check the role mapping (roles.*_labels) and mesh.model");

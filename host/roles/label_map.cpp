@@ -94,6 +94,23 @@ void note_label_coverage(const SceneRoles& r, const std::vector<uint16_t>& label
     if (listed[id] && !present[id]) absent.push_back(id);
     if (!listed[id] && present[id] && id != 0) unlisted.push_back(id);
   }
+  // A list none of whose ids occurs is a mapping written for another label map (another
+  // segmentation tool, another version of its ids): every voxel would silently take the wrong role.
+  const std::pair<const char*, const std::vector<int>*> lists[] = {
+      {"wall_labels", &r.wall_labels}, {"viscera_labels", &r.viscera_labels}, {"fixed_labels", &r.fixed_labels}};
+  for (const auto& [key, list] : lists) {
+    if (list->empty()) continue;
+    bool any = false;
+    for (int id : *list) any = any || present[std::size_t(id)];
+    if (any) continue;
+    std::vector<int> ids;
+    for (int id = 1; id < 65536 && ids.size() < 20; ++id)
+      if (present[id]) ids.push_back(id);
+    throw file_error(labels_name, std::string("none of the label ids in roles.") + key + " (" + id_list(*list) +
+                                      ") occurs in the label map (its ids: " + (ids.empty() ? "none" : id_list(ids)) +
+                                      (ids.size() == 20 ? ", ..." : "") +
+                                      "): the scene's mapping was written for another label map; fix roles." + key);
+  }
   if (!absent.empty())
     log::warn("roles: label ids listed in the scene but absent from " + labels_name + ": " + id_list(absent) +
               " (nothing to assign)");

@@ -24,7 +24,8 @@ void check_label_values(const Volume& labels, const std::string& labels_name);
 std::vector<Role> roles_from_labels(const std::vector<uint16_t>& label, const std::vector<Role>& table);
 
 /// Ids the scene lists (any role list) that the map does not hold: fine, but a warning names them
-/// (a typo in a scene shows up here). Ids the map holds that no list names get
+/// (a typo in a scene shows up here). A wall, viscera or fixed list none of whose ids the map holds
+/// is an InputError naming the list and the ids the map does hold (a mapping for another label map). Ids the map holds that no list names get
 /// unlisted_label_role: an info line names them.
 void note_label_coverage(const SceneRoles& roles, const std::vector<uint16_t>& label, const std::string& labels_name);
 

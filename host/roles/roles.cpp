@@ -1,6 +1,8 @@
 #include "roles/roles.h"
 
 #include <algorithm>
+#include <cmath>
+#include <sstream>
 
 #include "core/error.h"
 #include "io/volume_io.h"
@@ -20,6 +22,28 @@ void require_labels_if_needed(const Scene& s, bool have_labels) {
     throw InputError(scene_name(s) +
                      ": roles.source is \"labels\" but inputs.labels is not given; give a label map or set "
                      "roles.source to \"auto\"");
+}
+
+/// HU rules, padding and the warp all compare and interpolate HU values: a NaN or infinite voxel would
+/// silently take a role by accident and spread through interpolation. Refused, naming the first.
+void check_finite_ct(const Volume& ct, const std::string& name) {
+  if (ct.type() != VoxelType::Float32 && ct.type() != VoxelType::Float64) return;   // integers are finite
+  const int64_t n = ct.voxel_count();
+  int64_t bad = 0, first = n;
+  dispatch_voxel_type(ct.type(), const_cast<void*>(ct.raw()), [&](auto* p) {
+#pragma omp parallel for reduction(+ : bad) reduction(min : first) schedule(static)
+    for (int64_t v = 0; v < n; ++v)
+      if (!std::isfinite(static_cast<double>(p[v]))) {
+        ++bad;
+        first = std::min(first, v);
+      }
+  });
+  if (bad == 0) return;
+  const Index3& d = ct.geometry().dims;
+  std::ostringstream os;
+  os << bad << " voxels are NaN or infinite (the first at voxel (" << first % d[0] << ", " << (first / d[0]) % d[1]
+     << ", " << first / (int64_t(d[0]) * d[1]) << ")); replace them (e.g. by -1000 HU, air) before simulating";
+  throw file_error(name, os.str());
 }
 
 Volume padded_ct_float(const Volume& ct, const PadVoxels& pad) {
@@ -49,6 +73,7 @@ double RoleVolume::voxel_volume_ml() const {
 RoleVolume assign_roles(const Scene& scene, const Volume& ct, const Volume* labels) {
   require_labels_if_needed(scene, labels != nullptr);
   ct.geometry().validate(ct_name(scene));
+  check_finite_ct(ct, ct_name(scene));
   if (labels) {
     check_labels_on_ct_grid(ct.geometry(), labels->geometry(), ct_name(scene), labels_name(scene));
     check_label_values(*labels, labels_name(scene));

@@ -59,7 +59,7 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
     }
     if (inner.failed())
       throw DivergedError(
-          detail::newmark_failure(step + 1, inner.relative_change(), inner.iterations(), opt, dt, r.dt_stable_s),
+          detail::newmark_failure(step + 1, inner, opt, dt, r.dt_stable_s),
           r.dt_stable_s);
     for (int64_t n = 0; n < N; ++n) {
       x[n] = xp[n] + beta * dt * dt * a[n];

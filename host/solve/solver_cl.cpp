@@ -175,7 +175,7 @@ SolveResult newmark_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt
     }
     if (inner.failed())
       throw DivergedError(
-          detail::newmark_failure(step + 1, inner.relative_change(), inner.iterations(), opt, dt, r.dt_stable_s),
+          detail::newmark_failure(step + 1, inner, opt, dt, r.dt_stable_s),
           r.dt_stable_s);
     d.run(commit);
     ++step;

@@ -4,7 +4,9 @@
 #include <cstdio>
 #include <sstream>
 
+#include "core/log.h"
 #include "core/units.h"
+#include "solve/solvable.h"
 
 namespace pneumo::detail {
 
@@ -62,14 +64,17 @@ double newmark_acceleration_floor(const Mesh& m, const Monitor& mon) {
   return mon.reference_load() / heaviest;
 }
 
-std::string newmark_failure(int64_t step, double relative_change, int iterations, const SolveOptions& opt, double dt_s,
+std::string newmark_failure(int64_t step, const NewmarkInnerLoop& inner, const SolveOptions& opt, double dt_s,
                             double dt_stable_s) {
   std::ostringstream os;
   os.precision(3);
-  os << "newmark inner loop did not converge at step " << step << " (relative change " << relative_change
-     << " after " << iterations << " iterations, limit " << opt.newmark_inner_tolerance
-     << "): " << dt_advice(dt_s, dt_stable_s)
-     << "; the loop converges only for ωΔt < 2(√(1+ξ²) − ξ), like explicit integration";
+  os << "newmark inner loop did not converge at step " << step << " (relative change " << inner.relative_change()
+     << " after " << inner.iterations() << " iterations, limit " << opt.newmark_inner_tolerance << "): ";
+  if (inner.diverging())
+    os << dt_advice(dt_s, dt_stable_s) << "; the loop converges only for ωΔt < 2(√(1+ξ²) − ξ), like explicit integration";
+  else
+    os << "it was still converging when solver.newmark_max_inner (" << opt.newmark_max_inner
+       << ") ran out; raise it or solver.newmark_inner_tolerance, or set a smaller solver.dt_ms";
   return os.str();
 }
 
@@ -85,6 +90,7 @@ void apply_holds(const Mesh& m, std::vector<Vec3>& vec) {
 Monitor::Monitor(const Mesh& m, const SolveOptions& opt, const std::string& solver, SolveResult& r)
     : m_(m), opt_(opt), r_(r), start_(std::chrono::steady_clock::now()), progress_("solve " + solver, 0) {
   r.solver = solver;
+  check_solvable(m, opt);   // nothing free, or a part the load would carry away: no solver can answer
   // Reference load: the pressure's largest nodal force at rest.
   std::vector<Vec3> f(m.node_count(), Vec3::Zero());
   for (const auto& t : m.cavity_tris) {
@@ -129,6 +135,8 @@ void Monitor::check_diverged(const std::vector<Vec3>& x, int64_t step, const std
 void Monitor::check_diverged(double max_displacement_m, int64_t step, const std::string& advice) const {
   // A non-finite position makes max_displacement_m NaN or infinite: both fail the test below.
   if (max_displacement_m <= extent_m_) return;
+  // A dynamic scheme within its stable step did not blow up by Δt: do not tell the user to shrink it.
+  const bool dt_is_stable = r_.dt_s > 0.0 && r_.dt_s <= r_.dt_stable_s;
   std::ostringstream os;
   os.precision(3);
   os << r_.solver << " diverged at step " << step << " (";
@@ -136,7 +144,7 @@ void Monitor::check_diverged(double max_displacement_m, int64_t step, const std:
     os << "a node moved " << units::m_to_mm(max_displacement_m) << " mm, beyond the model's size";
   else
     os << "non-finite positions";
-  os << "): " << advice;
+  os << "): " << (dt_is_stable ? std::string(kLoadAdvice) + " (the time step is within its stable estimate)" : advice);
   throw DivergedError(os.str(), r_.dt_stable_s);
 }
 
@@ -214,6 +222,11 @@ void Monitor::finish(const std::vector<Vec3>& x, const std::vector<Vec3>& v, int
   r_.stop_reason = stop_reason;
   r_.residual = residual;
   r_.inverted_tetrahedra = count_inverted(m_, x);
+  if (r_.inverted_tetrahedra > 0 && opt_.on_inverted == OnInverted::Continue)
+    log::warn(r_.solver + ": " + std::to_string(r_.inverted_tetrahedra) + " of " + std::to_string(m_.tets.size()) +
+              " tetrahedra are inverted at the end (the load turned them inside out: the result is not physical "
+              "there); solver.on_inverted = \"stop\" stops at the first, a stiffer material or a lower pressure "
+              "avoids them");
   r_.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   char detail[160];
   std::snprintf(detail, sizeof detail, "%s after %lld steps, residual %.2e", stop_reason.c_str(), (long long)steps,

@@ -69,6 +69,8 @@ class NewmarkInnerLoop {
     if (!std::isfinite(change_)) return true;
     return change_ > tolerance_ * scale_ && !(change_ <= noise_floor_ * scale_);
   }
+  /// Failed because the change grew (or is not finite), not because the iteration cap came first.
+  bool diverging() const { return !std::isfinite(change_) || growing_ >= 3; }
   double relative_change() const { return change_ / scale_; }
   int iterations() const { return iterations_; }
 
@@ -96,13 +98,20 @@ std::string dt_advice(double dt_s, double dt_stable_s);
 /// reference load gives the heaviest node (near equilibrium |a| vanishes and rounding would
 /// otherwise look like divergence).
 double newmark_acceleration_floor(const Mesh& m, const Monitor& mon);
-/// The message of a Newmark inner loop that did not converge.
-std::string newmark_failure(int64_t step, double relative_change, int iterations, const SolveOptions& opt, double dt_s,
+/// The message of a Newmark inner loop that did not converge: a loop that diverged needs a smaller
+/// Δt; one still converging when solver.newmark_max_inner ran out needs more iterations.
+std::string newmark_failure(int64_t step, const NewmarkInnerLoop& inner, const SolveOptions& opt, double dt_s,
                             double dt_stable_s);
 inline const char* kKitasakaAdvice =
     "solver.kitasaka_step is too large for this mesh; try a smaller value (the paper uses 0.3)";
-inline const char* kStaticAdvice =
-    "the static solver failed to relax this load; check for unattached parts (no fixed nodes)";
+/// A run that left the model's size without a time step to blame (the static solvers, or a dynamic one
+/// within its stable step): the load is more than the material holds within the model (every part is
+/// anchored: check_solvable ran first).
+inline const char* kLoadAdvice =
+    "no equilibrium within the model's size: the pressure is too high for the material (lower "
+    "load.pressure_mmhg or raise material.young_kpa), or tetrahedra turned inside out (solver.on_inverted = "
+    "\"stop\" stops at the first)";
+inline const char* kStaticAdvice = kLoadAdvice;
 
 /// Zeroes the held world axes of each node (fixed nodes, symmetry planes).
 void apply_holds(const Mesh& m, std::vector<Vec3>& vec);

@@ -1,0 +1,49 @@
+// Writes the fuzzers' seed corpora: small valid volumes of every voxel type in every format pneumo
+// reads (so the fuzzers start from files that pass every header check and mutate from there), and
+// the scenes shipped in scenes/. Usage: make_seeds SOURCE_DIR OUT_DIR; OUT_DIR/{nifti,metaimage,scene}.
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include "io/volume_io.h"
+#include "scene/scene.h"
+
+namespace fs = std::filesystem;
+using namespace pneumo;
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: make_seeds SOURCE_DIR OUT_DIR\n");
+    return 2;
+  }
+  const fs::path source = argv[1], out = argv[2];
+  for (const char* sub : {"nifti", "metaimage", "scene"}) fs::create_directories(out / sub);
+  std::mt19937 rng(20261124);
+  const VoxelType types[] = {VoxelType::Int8,   VoxelType::UInt8,  VoxelType::Int16,   VoxelType::UInt16,
+                             VoxelType::Int32,  VoxelType::UInt32, VoxelType::Float32, VoxelType::Float64};
+  int n = 0;
+  for (VoxelType t : types) {
+    Geometry g;
+    g.dims = {3, 2, 2};
+    g.spacing_mm = Vec3(0.8, 1.0, 2.5);
+    g.origin_mm = Vec3(-10.0, 4.0, 7.5);
+    if (n % 2) g.direction = Mat3(Eigen::AngleAxisd(0.3, Vec3(0, 0, 1)));   // an oblique grid too
+    Volume v(g, t);
+    auto* bytes = static_cast<unsigned char*>(v.raw());
+    for (std::size_t i = 0; i < v.byte_count(); ++i) bytes[i] = static_cast<unsigned char>(rng() & 0x3f);
+    const std::string stem = "t" + std::to_string(n++);
+    write_volume(v, (out / "nifti" / (stem + ".nii")).string());
+    write_volume(v, (out / "nifti" / (stem + ".nii.gz")).string());
+    write_volume(v, (out / "metaimage" / (stem + ".mha")).string());
+    write_volume(v, (out / "metaimage" / (stem + "_z.mha")).string(), WriteOptions{true});
+  }
+  for (const auto& e : fs::directory_iterator(source / "scenes"))
+    if (e.path().extension() == ".json")
+      fs::copy_file(e.path(), out / "scene" / e.path().filename(), fs::copy_options::overwrite_existing);
+  // Every key at its default (unset ones as null): each section and key is in the corpus once.
+  std::ofstream(out / "scene" / "default_echo.json") << default_scene().echo().dump(2) << "\n";
+  return 0;
+}
