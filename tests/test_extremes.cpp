@@ -222,7 +222,9 @@ TEST(ExtremeMaterial, YoungFrom1kPaTo1MPa) {
     std::printf("E = %6.0f kPa: %s after %lld steps, lift %.4f mm\n", young_kpa, r.stop_reason.c_str(),
                 (long long)r.steps, units::m_to_mm(lift(m, r.x)));
     if (young_kpa == 100.0) lift_times_e_100 = lift(m, r.x) * young_kpa;
-    if (young_kpa == 1000.0) EXPECT_NEAR(lift(m, r.x) * young_kpa, lift_times_e_100, 0.03 * lift_times_e_100);
+    if (young_kpa == 1000.0) {
+      EXPECT_NEAR(lift(m, r.x) * young_kpa, lift_times_e_100, 0.03 * lift_times_e_100);
+    }
   }
 }
 
@@ -250,7 +252,9 @@ TEST(ExtremeLoad, PressuresFrom0To60MmHg) {
       EXPECT_GT(l, previous);
     }
     if (mmhg == 1.0) lift_1 = l;
-    if (mmhg == 12.0) EXPECT_NEAR(l / 12.0, lift_1, 0.05 * lift_1);
+    if (mmhg == 12.0) {
+      EXPECT_NEAR(l / 12.0, lift_1, 0.05 * lift_1);
+    }
     previous = l;
   }
 }
@@ -453,7 +457,9 @@ TEST(ExtremeInversion, InvertedTetrahedraAreCountedReportedAndStopTheRunWhenAske
     EXPECT_FALSE(stopped.converged);
     EXPECT_GT(stopped.inverted_tetrahedra, 0);
     EXPECT_EQ(stopped.inverted_tetrahedra, count_inverted(m, stopped.x));
-    if (method == SolverMethod::Static) EXPECT_LT(stopped.steps, went_on.steps);
+    if (method == SolverMethod::Static) {
+      EXPECT_LT(stopped.steps, went_on.steps);
+    }
     std::printf("%s, on_inverted = stop: stopped after %lld steps with %lld inverted (continue: %lld inverted, "
                 "converged after %lld steps)\n",
                 enum_name(method), (long long)stopped.steps, (long long)stopped.inverted_tetrahedra,
