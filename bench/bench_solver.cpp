@@ -27,29 +27,7 @@
 //                          between passes, and the DRAM-triad roofline is then a conservative bound (a fraction
 //                          above 1 is possible)
 //
-// Peak float32 is assumed 115 GFLOP/s per core (platform.md: ~230 GFLOP/s on the 2-core Zen 4 with float8/16
-// arithmetic), double half of that; per OpenCL device its compute units × that. Set PNEUMO_BENCH_PEAK_GFLOP_S to
-// override the whole device's float32 peak (e.g. for a GPU).
-//
-// Byte counts (every array streamed once per pass; the gathers of neighbours' state are counted as cache hits, since
-// neighbours lie within a few lattice planes of the node; an element pass reads each distinct vertex's state once).
-// A write counts once, as the triad counts it. They follow kernels/msd_forces.cl and msd_integrators.cl (state as
-// displacements u = x − x₀) and host/solve/forces.cpp; change them with the kernels.
-//   OpenCL, node_forces:  u, v (float4 each), mass (float), its block's node id (int), force written (float4), and
-//                         the block records of the spring table: spring_records_per_node × (index, k, c, rest x, y,
-//                         z, length: 4 B each) = 28 B per record (a node has 10.6 springs on average on the phantom
-//                         meshes; blocks group equal degrees, so padding adds little). Pressure on:
-//                         triangle_pressure reads each triangle's int4 and its vertices' u and x₀ (float4 each) and
-//                         writes its force (float4), which node_forces reads back, plus per node its triangle
-//                         records (4 B each, counted as its degree + 1). Volume term on: likewise per tetrahedron
-//                         (int4, vertices' u and x₀, 4 float4 forces written and read) and its records.
-//   OpenCL, integrator:   explicit_step reads u, v, force, the hold mask (float4 each) and 1/m (float), writes u
-//                         and v: 100 B per node.
-//   CPU reference:        double Vec3 (24 B). Per spring: its 2 node ids, k, c, rest length, its force written and
-//                         read back by the gather, 2 adjacency entries; per node: x, v, mass, the adjacency row
-//                         start, the force written; per triangle: ids, its vertices' x, force written and read, 3
-//                         adjacency entries (+ each node's row start). Integrator: reads x, v, f, mass, hold;
-//                         writes x, v.
+// Peak FLOP rates and the byte and FLOP counts per node-update: common/solver_cost.h (shared with `pneumo bench`).
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -71,6 +49,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cl/cl_runtime.h"
+#include "common/cpu_load.h"
+#include "common/solver_cost.h"
 #include "core/log.h"
 #include "core/progress.h"
 #include "mesh/adjacency.h"
@@ -85,6 +65,11 @@
 #include "solve/solver_cl.h"
 
 using namespace pneumo;
+using pneumo::bench::Cost;
+using pneumo::bench::CpuSample;
+using pneumo::bench::cpu_sample;
+using pneumo::bench::cl_peak_flop_s;
+using pneumo::bench::kPeakF32PerCore;
 
 namespace {
 
@@ -93,7 +78,6 @@ using Clock = std::chrono::steady_clock;
 constexpr int kStepsPerIteration = 10;                // explicit steps per timed iteration
 constexpr std::size_t kTriadBytes = 512ull << 20;     // per array, far beyond the 32 MiB L3 (as bench_foundation)
 constexpr int kTriadReps = 5;
-constexpr double kPeakF32PerCore = 115e9;             // platform.md: ~230 GFLOP/s float32 on 2 cores
 /// The meshes: the three phantoms as their scenes mesh them (8–9 mm cubes: working sets of 14–34 MiB, about the
 /// 32 MiB L3), and the large phantom at 3 mm cubes (cube_voxels 4: ~0.9 M nodes, a working set of ~300 MiB), where
 /// the data cannot stay in cache and the DRAM roofline is the honest bound.
@@ -194,98 +178,18 @@ ClDevice& cl_device(const ocl::DeviceInfo& info) {
   return d;
 }
 
-double cl_peak_flop_s(const ocl::DeviceInfo& info) {
-  if (const char* e = std::getenv("PNEUMO_BENCH_PEAK_GFLOP_S")) return std::atof(e) * 1e9;
-  return kPeakF32PerCore * std::max(1u, info.compute_units);
-}
 
-// ---- bytes and FLOPs per node-update, from the data structures --------------------------------
-
-struct Cost {
-  double bytes = 0.0, flops = 0.0;   // per node
-};
-
-/// Σ over nodes of (degree + 1): the entries of an element table a node's gather reads (its own and about one of
-/// padding).
-double table_reads(const Csr& c, int64_t nodes) {
-  double r = 0.0;
-  for (int64_t n = 0; n < nodes; ++n) r += double(c.end(n) - c.begin(n) + 1);
-  return r;
-}
-
-/// How many distinct nodes a list of elements touches.
-template <std::size_t K>
-double distinct_nodes(const std::vector<std::array<int32_t, K>>& elements, int64_t nodes) {
-  std::vector<char> seen(std::size_t(nodes), 0);
-  for (const auto& e : elements)
-    for (const int32_t n : e) seen[std::size_t(n)] = 1;
-  return double(std::count(seen.begin(), seen.end(), 1));
-}
-
-// FLOPs. OpenCL node_forces, one spring record (nonlinear, damped; padding records compute too): du, dv, d = rest +
-// du (9), length (6), reciprocal and direction (4), elastic part (5), damper (9), sum into f (6).
-constexpr double kFlopsSpringEndCl = 39;
-// CPU reference: one evaluation per spring (d, length, direction, elastic part, damper: 29), then ± gathered at
-// both ends (3 each).
-constexpr double kFlopsSpringCpu = 29 + 6;
-constexpr double kFlopsTriangleCl = 36 + 9;     // two edges from rest + displacement, area normal, scaled; 3 gathers
-constexpr double kFlopsTriangleCpu = 24 + 9;    // two edges, area normal, scaled; 3 gathers
-constexpr double kFlopsTet = 90 + 12;           // 3 edges, 3 cross products, volumes, scale; 4 gathers
-constexpr double kFlopsGravity = 3;
-constexpr double kFlopsIntegratorCpu = 13;      // dt/m, v += (dt/m) f, x += dt v
-constexpr double kFlopsIntegratorCl = 16;       // the same and the hold mask's multiply
-
-constexpr double kClSpringRecordBytes = 7 * 4;                    // index, k, c, rest x, y, z, length
-constexpr double kClIntegratorBytes = 3 * 16 + 16 + 4 + 2 * 16;   // u, v, f, hold mask, 1/m; u, v written
-constexpr double kCpuIntegratorBytes = 3 * 24 + 8 + 1 + 2 * 24;   // x, v, f, mass, hold; x, v written
-
-/// gathered: the share of node blocks node_forces runs on (1, or the blocks with a free node in a solver's step).
-Cost cl_force_cost(const Mesh& m, const ForceModel& model, double spring_records_per_node, double gathered) {
-  const int64_t N = m.node_count();
-  const double R = double(m.cavity_tris.size()), T = double(m.tets.size());
-  double bytes = double(N) * (gathered * (16 + 16 + 4 + 4 + 16) + spring_records_per_node * kClSpringRecordBytes);
-  double flops = double(N) * (spring_records_per_node * kFlopsSpringEndCl + kFlopsGravity);
-  if (model.pressure_pa != 0.0 && R > 0) {
-    const Adjacency a = Adjacency::of(m);
-    bytes += R * (16 + 16 + 16) + 32 * distinct_nodes(m.cavity_tris, N) + 4 * table_reads(a.tris, N);
-    flops += R * kFlopsTriangleCl;
-  }
-  if (model.volume_stiffness_pa != 0.0 && T > 0) {
-    const Adjacency a = Adjacency::of(m);
-    bytes += T * (16 + 64 + 64) + 32 * distinct_nodes(m.tets, N) + 4 * table_reads(a.tets, N);
-    flops += T * kFlopsTet;
-  }
-  return Cost{bytes / double(N), flops / double(N)};
-}
-
-Cost cpu_force_cost(const Mesh& m, const ForceModel& model) {
-  const int64_t N = m.node_count();
-  const double S = double(m.springs.size()), R = double(m.cavity_tris.size()), T = double(m.tets.size());
-  double bytes = double(N) * (24 + 24 + 8 + 8 + 24) + S * (8 + 3 * 8 + 24 + 24 + 2 * 4);
-  double flops = S * kFlopsSpringCpu + double(N) * kFlopsGravity;
-  if (model.pressure_pa != 0.0 && R > 0) {
-    bytes += R * (12 + 24 + 24 + 3 * 4) + 24 * distinct_nodes(m.cavity_tris, N) + double(N) * 8;
-    flops += R * kFlopsTriangleCpu;
-  }
-  if (model.volume_stiffness_pa != 0.0 && T > 0) {
-    bytes += T * (16 + 8 + 2 * 96 + 4 * 4) + 24 * distinct_nodes(m.tets, N) + double(N) * 8;
-    flops += T * kFlopsTet;
-  }
-  return Cost{bytes / double(N), flops / double(N)};
-}
 
 /// Sets the roofline counters from the achieved node rate (node-updates or node force evaluations per second).
 void report_roofline(benchmark::State& state, const Mesh& m, const Cost& cost, double node_rate,
                      double bandwidth_gb_s, double peak_flop_s, const std::string& device_label) {
-  const double mem_bound = bandwidth_gb_s * 1e9 / cost.bytes;
-  const double flop_bound = peak_flop_s / cost.flops;
-  const bool memory = mem_bound <= flop_bound;
+  const pneumo::bench::Roofline r = pneumo::bench::roofline(node_rate, cost, bandwidth_gb_s, peak_flop_s);
   state.counters["bytes_per_node_update"] = cost.bytes;
   state.counters["flops_per_node_update"] = cost.flops;
   state.counters["bandwidth_gb_s"] = bandwidth_gb_s;
-  state.counters["roofline_fraction"] = node_rate / std::min(mem_bound, flop_bound);
+  state.counters["roofline_fraction"] = r.fraction;
   state.counters["working_set_mib"] = cost.bytes * double(m.node_count()) / double(1 << 20);
-  state.SetLabel(device_label + (memory ? ", memory-bound" : ", compute-bound"));
+  state.SetLabel(device_label + (r.memory_bound ? ", memory-bound" : ", compute-bound"));
 }
 
 void mesh_counters(benchmark::State& state, const Mesh& m) {
@@ -297,44 +201,9 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 
 // ---- contention: CPU used by other processes while a benchmark ran (Linux /proc; −1 elsewhere) ----
 
-struct CpuSample {
-  double busy_s = -1.0, own_s = -1.0;   // all CPUs' busy time; this process's (all its threads, PoCL's included)
-  Clock::time_point t = Clock::now();
-};
-
-CpuSample cpu_sample() {
-  CpuSample s;
-  const double tick = double(::sysconf(_SC_CLK_TCK));
-  if (std::FILE* f = std::fopen("/proc/stat", "r")) {
-    unsigned long long user, nice, system, idle, iowait, irq, softirq;
-    if (std::fscanf(f, "cpu %llu %llu %llu %llu %llu %llu %llu", &user, &nice, &system, &idle, &iowait, &irq,
-                    &softirq) == 7)
-      s.busy_s = double(user + nice + system + irq + softirq) / tick;
-    std::fclose(f);
-  }
-  if (std::FILE* f = std::fopen("/proc/self/stat", "r")) {
-    char buf[1024];
-    const std::size_t len = std::fread(buf, 1, sizeof buf - 1, f);
-    buf[len] = 0;
-    std::fclose(f);
-    // Fields after the command name (which may hold spaces): state is field 3, utime 14, stime 15.
-    if (const char* p = std::strrchr(buf, ')')) {
-      unsigned long long utime = 0, stime = 0;
-      if (std::sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &utime, &stime) == 2)
-        s.own_s = double(utime + stime) / tick;
-    }
-  }
-  return s;
-}
-
 /// Cores' worth of CPU that other processes used between a and b (e.g. 0.9: another job held a core).
 void report_other_cores(benchmark::State& state, const CpuSample& a, const CpuSample& b) {
-  const double wall = std::chrono::duration<double>(b.t - a.t).count();
-  if (a.busy_s < 0 || a.own_s < 0 || b.busy_s < 0 || b.own_s < 0 || wall <= 0) {
-    state.counters["other_cores"] = -1.0;
-    return;
-  }
-  state.counters["other_cores"] = std::max(0.0, ((b.busy_s - a.busy_s) - (b.own_s - a.own_s)) / wall);
+  state.counters["other_cores"] = pneumo::bench::other_cores(a, b);
 }
 
 /// Runs `fn` with OpenMP limited to `threads`, restoring the previous limit after.
@@ -371,7 +240,7 @@ void BM_ForcesCpu(benchmark::State& state, const Case& size, int threads) {
   state.counters["force_evals_per_s"] = benchmark::Counter(evals, benchmark::Counter::kIsRate);
   state.counters["node_updates_per_s"] = benchmark::Counter(evals * N, benchmark::Counter::kIsRate);
   mesh_counters(state, m);
-  report_roofline(state, m, cpu_force_cost(m, mc.model), evals * N / seconds, bw, 0.5 * kPeakF32PerCore * threads,
+  report_roofline(state, m, pneumo::bench::cpu_force_cost(m, mc.model), evals * N / seconds, bw, pneumo::bench::cpu_peak_flop_s(threads),
                   "CPU reference, double, " + std::to_string(threads) + " thread(s)");
 }
 
@@ -418,10 +287,8 @@ void BM_ExplicitStepCpu(benchmark::State& state, const Case& size, int threads) 
   state.counters["force_evals_per_s"] = benchmark::Counter(steps, benchmark::Counter::kIsRate);
   state.counters["node_updates_per_s"] = benchmark::Counter(steps * double(N), benchmark::Counter::kIsRate);
   mesh_counters(state, m);
-  Cost cost = cpu_force_cost(m, mc.model);
-  cost.bytes += kCpuIntegratorBytes;
-  cost.flops += kFlopsIntegratorCpu;
-  report_roofline(state, m, cost, steps * double(N) / seconds, bw, 0.5 * kPeakF32PerCore * threads,
+  const Cost cost = pneumo::bench::cpu_step_cost(m, mc.model);
+  report_roofline(state, m, cost, steps * double(N) / seconds, bw, pneumo::bench::cpu_peak_flop_s(threads),
                   "CPU reference, double, " + std::to_string(threads) + " thread(s)");
 }
 
@@ -462,7 +329,7 @@ void BM_ForcesCl(benchmark::State& state, Case size, ocl::DeviceInfo info) {
     state.counters["node_updates_per_s"] = benchmark::Counter(evals * N, benchmark::Counter::kIsRate);
     state.counters["spring_records_per_node"] = eval.spring_records_per_node();
     mesh_counters(state, mc.mesh);
-    report_roofline(state, mc.mesh, cl_force_cost(mc.mesh, mc.model, eval.spring_records_per_node(), 1.0), evals * N / seconds,
+    report_roofline(state, mc.mesh, pneumo::bench::cl_force_cost(mc.mesh, mc.model, eval.spring_records_per_node(), 1.0), evals * N / seconds,
                     dev.bandwidth_gb_s, cl_peak_flop_s(info), info.name + ", float32");
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
@@ -504,9 +371,7 @@ void BM_ExplicitStepCl(benchmark::State& state, Case size, ocl::DeviceInfo info)
     state.counters["spring_records_per_node"] = spring_records;
     state.counters["gathered_fraction"] = gathered;
     mesh_counters(state, mc.mesh);
-    Cost cost = cl_force_cost(mc.mesh, mc.model, spring_records, gathered);
-    cost.bytes += kClIntegratorBytes;
-    cost.flops += kFlopsIntegratorCl;
+    const Cost cost = pneumo::bench::cl_step_cost(mc.mesh, mc.model, spring_records, gathered);
     report_roofline(state, mc.mesh, cost, steps * N / seconds, dev.bandwidth_gb_s, cl_peak_flop_s(info),
                     info.name + ", float32");
   } catch (const std::exception& e) {

@@ -23,14 +23,9 @@
 //   x_vtk, x_itk        voxels_per_s over the peers measured on this machine (../shared/peers/RESULTS-2026-11.md):
 //                       VTK vtkProbeFilter pull-back 1.04 Mvoxel/s, ITK dense-field resampling 29.5 Mvoxel/s
 //
-// Bytes per output voxel: the source CT (float32), roles (1 B) and labels (2 B) are read about once
-// (a smooth deformation reads each source voxel about once; the padding the roles added is read only
-// where mapped), the CT (4 B), labels (2 B) and outcome (1 B) written once; OpenCL adds the owner
-// buffer (4 B written by the fill, read by the scatter's check and the sample pass: 12 B) and the
-// host↔device copies (source 7 B, results 7 B, each read and written: 28 B).
+// Bytes per output voxel: common/warp_cost.h (shared with `pneumo bench`).
 #include <benchmark/benchmark.h>
 #include <omp.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -43,6 +38,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cl/cl_runtime.h"
+#include "common/cpu_load.h"
+#include "common/warp_cost.h"
 #include "core/log.h"
 #include "core/progress.h"
 #include "perf/bandwidth.h"
@@ -59,10 +56,13 @@ using Clock = std::chrono::steady_clock;
 
 constexpr std::size_t kTriadBytes = 512ull << 20;
 constexpr int kTriadReps = 5;
-constexpr double kVtkVoxelsPerS = 1.04e6;    // ../shared/peers/RESULTS-2026-11.md, warp_probe probe_mvox_per_s
-constexpr double kItkVoxelsPerS = 29.5e6;    // itk_double_file mvox_per_s_median (2 threads)
-constexpr double kCpuBytesPerVoxel = 4 + 1 + 2 + 4 + 2 + 1;
-constexpr double kClBytesPerVoxel = kCpuBytesPerVoxel + 12 + 28;
+using bench::CpuSample;
+using bench::cpu_sample;
+using bench::other_cores;
+constexpr double kVtkVoxelsPerS = bench::kVtkWarpVoxelsPerS;
+constexpr double kItkVoxelsPerS = bench::kItkWarpVoxelsPerS;
+constexpr double kCpuBytesPerVoxel = bench::kWarpCpuBytesPerVoxel;
+constexpr double kClBytesPerVoxel = bench::kWarpClBytesPerVoxel;
 
 struct WarpCase {
   RoleVolume roles;
@@ -101,42 +101,6 @@ const WarpCase& warp_case() {
 }
 
 WarpOptions options() { return WarpOptions{}; }
-
-struct CpuSample {
-  double busy_s = -1.0, own_s = -1.0;
-  Clock::time_point t = Clock::now();
-};
-
-/// All CPUs' busy time and this process's, from /proc (the machine is shared: see other_cores).
-CpuSample cpu_sample() {
-  CpuSample s;
-  const double tick = double(::sysconf(_SC_CLK_TCK));
-  if (std::FILE* f = std::fopen("/proc/stat", "r")) {
-    unsigned long long user, nice, system, idle, iowait, irq, softirq;
-    if (std::fscanf(f, "cpu %llu %llu %llu %llu %llu %llu %llu", &user, &nice, &system, &idle, &iowait, &irq,
-                    &softirq) == 7)
-      s.busy_s = double(user + nice + system + irq + softirq) / tick;
-    std::fclose(f);
-  }
-  if (std::FILE* f = std::fopen("/proc/self/stat", "r")) {
-    char buf[1024];
-    const std::size_t len = std::fread(buf, 1, sizeof buf - 1, f);
-    buf[len] = 0;
-    std::fclose(f);
-    if (const char* p = std::strrchr(buf, ')')) {
-      unsigned long long utime = 0, stime = 0;
-      if (std::sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &utime, &stime) == 2)
-        s.own_s = double(utime + stime) / tick;
-    }
-  }
-  return s;
-}
-
-double other_cores(const CpuSample& a, const CpuSample& b) {
-  const double wall = std::chrono::duration<double>(b.t - a.t).count();
-  if (a.busy_s < 0 || a.own_s < 0 || b.busy_s < 0 || b.own_s < 0 || wall <= 0) return -1.0;
-  return std::max(0.0, ((b.busy_s - a.busy_s) - (b.own_s - a.own_s)) / wall);
-}
 
 void report(benchmark::State& state, double seconds, int64_t voxels, double bytes_per_voxel, double bandwidth_gb_s,
             const CpuSample& c0, const std::string& label) {

@@ -230,7 +230,7 @@ TEST(SceneErrors, UnknownKeyNestedSuggestsClosest) {
   EXPECT_CONTAINS(error_of({{"material", {{"young", 30}}}}), "did you mean material.young_kpa?");
   // Nothing close: the known keys of that object are listed.
   const std::string e = error_of({{"mesh", {{"zzzzzzzzzz", 1}}}});
-  EXPECT_CONTAINS(e, "mesh.zzzzzzzzzz is an unknown key; known keys in mesh: cube_voxels, model");
+  EXPECT_CONTAINS(e, "mesh.zzzzzzzzzz is an unknown key; known keys in mesh: cube_voxels, cube_mm, model");
 }
 
 TEST(SceneErrors, UnknownKeyInArrayItemCarriesIndex) {

@@ -18,5 +18,6 @@ Run add_simulate(CLI::App& app);
 Run add_render(CLI::App& app);
 Run add_run(CLI::App& app);
 Run add_warp(CLI::App& app);
+Run add_bench(CLI::App& app);
 
 }  // namespace pneumo::cli

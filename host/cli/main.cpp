@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   add(cli::add_warp);
   add(cli::add_render);
   add(cli::add_run);
+  add(cli::add_bench);
 
   try {
     app.parse(argc, argv);

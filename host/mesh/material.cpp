@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "mesh/mesh.h"
+#include "scene/scene_presets.h"
 
 namespace pneumo {
 
@@ -32,7 +33,7 @@ void assign_material(Mesh& m, const MaterialOptions& opt) {
 
 Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene) {
   MeshOptions opt;
-  opt.cube_voxels = scene.mesh.cube_voxels;
+  opt.cube_voxels = cube_voxels_for(scene.mesh, roles.geometry);
   opt.model = scene.mesh.model;
   opt.roi_min_mm = scene.mesh.roi_min_mm;
   opt.roi_max_mm = scene.mesh.roi_max_mm;

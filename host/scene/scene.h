@@ -31,6 +31,8 @@ enum class SolverMethod : uint8_t { Static, Explicit, Newmark, Kitasaka2004 };
 enum class OnInverted : uint8_t { Continue, Stop };
 enum class Lens : uint8_t { Pinhole, Fisheye };
 enum class RenderPreset : uint8_t { Laparoscopic, CtSoftTissue, CtMuscle, CtAaa, CtAir, Custom };
+/// Speed against accuracy (scene_presets.h): what `pneumo bench` measured each to buy.
+enum class ScenePreset : uint8_t { None, Preview, Balanced, Accurate };
 
 /// How each enum's values are written in scene files, indexed by the value: the one place these
 /// names are spelled (the parser, the reference and enum_name() all read them from here).
@@ -64,6 +66,10 @@ template <> struct EnumNames<RenderPreset> {
                                                     "ct-aaa", "ct-air", "custom"};
 };
 
+template <> struct EnumNames<ScenePreset> {
+  static constexpr std::array<const char*, 4> names{"none", "preview", "balanced", "accurate"};
+};
+
 /// The scene-file name of an enum value ("kitasaka2004", "ct-muscle", ...).
 template <class E> const char* enum_name(E e) {
   return EnumNames<E>::names[static_cast<std::size_t>(e)];
@@ -94,6 +100,7 @@ struct SceneRoles {
 
 struct SceneMesh {
   int cube_voxels = 8;  // L, Nimura's value (§4 defaults)
+  std::optional<double> cube_mm;  // when set, L from the CT's spacing (cube_voxels_for)
   MeshModel model = MeshModel::WallViscera;
   std::optional<Vec3> roi_min_mm, roi_max_mm;  // both or neither
 };
@@ -228,6 +235,7 @@ struct Landmark {
 struct Scene {
   int schema_version = 1;
   std::string name, description;
+  ScenePreset preset = ScenePreset::None;   // applied while parsing: see scene_presets.h
   SceneInputs inputs;
   SceneRoles roles;
   SceneMesh mesh;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "scene/param_table.h"
+#include "scene/scene_presets.h"
 
 namespace pneumo::scene_detail {
 namespace {
@@ -115,6 +116,9 @@ const Table<SceneMesh>& mesh_table() {
   static const Table<SceneMesh> t{
       {"cube_voxels", &SceneMesh::cube_voxels, "voxels", in(1, 64),
        "L: each mesh cube covers L×L×L voxels, split into 5 tetrahedra (§3; Nimura: 8)."},
+      {"cube_mm", &SceneMesh::cube_mm, "mm", above(0, 1000),
+       "Cube edge in mm instead of voxels: L = the whole number of voxels nearest to it along the CT's coarsest "
+       "axis (at least 1). Unset: cube_voxels. The presets set it, so they mean the same on any CT."},
       {"model", &SceneMesh::model, "", any(),
        "\"wall_viscera\": wall and viscera are two meshes, the gas opens between them (§3); "
        "\"wall\": the wall alone, pressure on its inner surface."},
@@ -347,6 +351,7 @@ const Table<Scene>& scene_table() {
       {"$schema_version", &Scene::schema_version, "", in(1, 1), "Version of this format; optional."},
       {"name", &Scene::name, "", any(), "Short name of the case (reports, window titles)."},
       {"description", &Scene::description, "", any(), "Free text."},
+      {"preset", &Scene::preset, "", any(), preset_reference_text().c_str()},
       {"inputs", &Scene::inputs, inputs_table(), "Input volumes."},
       {"roles", &Scene::roles, roles_table(), "Which voxels are wall, viscera, fixed or left out (§2)."},
       {"mesh", &Scene::mesh, mesh_table(), "The tetrahedral meshes (§3)."},

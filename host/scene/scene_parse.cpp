@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "scene/param_table.h"
 #include "scene/scene.h"
+#include "scene/scene_presets.h"
 
 namespace pneumo {
 namespace {
@@ -130,7 +131,14 @@ Scene parse_scene(const nlohmann::json& j, const std::string& origin_path) {
   ctx.root = &scene_detail::scene_table();
 
   Scene s;
-  scene_detail::scene_table().read(s, j, scene_detail::At{&ctx, ""});
+  // A preset supplies values for the keys the scene does not give itself (merge_patch: the scene's keys win).
+  // A misspelt preset is left to the table, which names the allowed values.
+  nlohmann::json merged = j;
+  if (const std::optional<ScenePreset> p = find_preset(j); p && *p != ScenePreset::None) {
+    merged = preset_patch(*p);
+    merged.merge_patch(j);
+  }
+  scene_detail::scene_table().read(s, merged, scene_detail::At{&ctx, ""});
   scene_detail::validate_scene(s, ctx);
   s.path = origin_path;
   s.folder = ctx.folder;

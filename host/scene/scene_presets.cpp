@@ -1,0 +1,73 @@
+#include "scene/scene_presets.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace pneumo {
+
+namespace {
+
+// Chosen from the Pareto front of bench/results/2026-11-23-bench.md: the medium phantom (1.5 mm voxels) at 12 mmHg,
+// the CPU reference on 1 thread, errors at skin and cavity-surface points against the static solver at 4.5 mm cubes
+// and tolerance 1e-5. The cube size is what buys accuracy there: below 1e-2 the tolerance changed the error by
+// < 0.03 mm at every cube size, and the dynamic schemes reached the same error as the static solver at the same
+// cube size in 10-100× the time. "accurate" keeps 1e-3 (same error there, +0.8 s) as a margin for cases stiffer or
+// more nonlinear than the phantom. The texts say what each measured to buy (solve time, RMS / max error).
+const PresetSettings kPreview{SolverMethod::Static, 12.0, 1e-2, "measured: solve 0.17 s, error RMS 2.5 mm, max 7.5 mm"};
+const PresetSettings kBalanced{SolverMethod::Static, 9.0, 1e-2, "measured: solve 0.41 s, error RMS 1.7 mm, max 5.4 mm"};
+const PresetSettings kAccurate{SolverMethod::Static, 6.0, 1e-3, "measured: solve 3.1 s, error RMS 0.63 mm, max 2.1 mm"};
+
+}  // namespace
+
+const PresetSettings& preset_settings(ScenePreset p) {
+  switch (p) {
+    case ScenePreset::Preview: return kPreview;
+    case ScenePreset::Balanced: return kBalanced;
+    case ScenePreset::Accurate: return kAccurate;
+    case ScenePreset::None: break;
+  }
+  throw std::invalid_argument("preset \"none\" has no settings");
+}
+
+nlohmann::json preset_patch(ScenePreset p) {
+  const PresetSettings& s = preset_settings(p);
+  return {{"mesh", {{"cube_mm", s.cube_mm}}},
+          {"solver", {{"method", enum_name(s.method)}, {"residual_tolerance", s.residual_tolerance}}}};
+}
+
+std::optional<ScenePreset> find_preset(const nlohmann::json& scene) {
+  if (!scene.is_object()) return std::nullopt;
+  const auto it = scene.find("preset");
+  if (it == scene.end() || !it->is_string()) return std::nullopt;
+  const auto& names = EnumNames<ScenePreset>::names;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (*it == names[i]) return static_cast<ScenePreset>(i);
+  return std::nullopt;
+}
+
+const std::string& preset_reference_text() {
+  static const std::string text = [] {
+    std::string t = "Speed against accuracy, measured by `pneumo bench` (README, bench/results/2026-11-23-bench.md: the "
+                    "medium phantom, CPU 1 thread, error at skin and cavity points against 4.5 mm cubes): sets "
+                    "mesh.cube_mm, solver.method and solver.residual_tolerance unless the scene gives them. "
+                    "\"none\": the defaults.";
+    for (const ScenePreset p : {ScenePreset::Preview, ScenePreset::Balanced, ScenePreset::Accurate}) {
+      const PresetSettings& s = preset_settings(p);
+      char b[256];
+      std::snprintf(b, sizeof b, " \"%s\": %s, %g mm cubes, tolerance %g (%s).", enum_name(p), enum_name(s.method),
+                    s.cube_mm, s.residual_tolerance, s.measured);
+      t += b;
+    }
+    return t;
+  }();
+  return text;
+}
+
+int cube_voxels_for(const SceneMesh& mesh, const Geometry& grid) {
+  if (!mesh.cube_mm) return mesh.cube_voxels;
+  return std::max(1, int(std::lround(*mesh.cube_mm / grid.spacing_mm.maxCoeff())));
+}
+
+}  // namespace pneumo

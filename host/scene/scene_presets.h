@@ -1,0 +1,39 @@
+#pragma once
+// Speed against accuracy in one key: a scene's "preset" ("preview", "balanced", "accurate") supplies the cube size,
+// the solver and its tolerance, each measured by `pneumo bench` (bench/results/*-bench.md: wall time and
+// displacement error against a converged fine solution on the medium phantom). Keys the scene gives itself win
+// over the preset's, so a preset is a starting point, not a lock; "none" (the default) leaves the defaults.
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "core/geometry.h"
+#include "scene/scene.h"
+
+namespace pneumo {
+
+struct PresetSettings {
+  SolverMethod method = SolverMethod::Static;
+  double cube_mm = 9.0;
+  double residual_tolerance = 1e-3;
+  const char* measured = "";   // what the committed benchmark measured it to buy (for the reference)
+};
+
+/// The settings of a preset other than None (std::invalid_argument for None).
+const PresetSettings& preset_settings(ScenePreset p);
+
+/// {"mesh": {"cube_mm": …}, "solver": {"method": …, "residual_tolerance": …}}: what parsing merges under the scene.
+nlohmann::json preset_patch(ScenePreset p);
+
+/// The preset a scene's JSON names, when it names a known one (top-level "preset").
+std::optional<ScenePreset> find_preset(const nlohmann::json& scene);
+
+/// The reference text of the "preset" key: each preset's settings and what it measured to buy.
+const std::string& preset_reference_text();
+
+/// L of a scene's mesh on a grid: cube_mm when set (the nearest whole number of voxels along the coarsest axis,
+/// at least 1), else cube_voxels.
+int cube_voxels_for(const SceneMesh& mesh, const Geometry& grid);
+
+}  // namespace pneumo
