@@ -1,4 +1,5 @@
 #include "report/plot_svg.h"
+#include "report/markup.h"
 
 #include <algorithm>
 #include <cstdlib>
@@ -9,18 +10,6 @@
 namespace pneumo {
 
 namespace {
-
-std::string escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '&') out += "&amp;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
-  }
-  return out;
-}
 
 std::string number(double v) {
   char buf[32];
@@ -88,7 +77,7 @@ std::string line_plot_svg(const std::vector<PlotSeries>& series, const PlotOptio
     << " " << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n";
   o << "<rect x=\"0\" y=\"0\" width=\"" << W << "\" height=\"" << H << "\" fill=\"white\"/>\n";
   if (!opt.title.empty())
-    o << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">" << escape(opt.title)
+    o << "<text x=\"" << W / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">" << escape_markup(opt.title)
       << "</text>\n";
   // Grid and ticks.
   for (double t : nice_ticks(x0, x1)) {
@@ -112,10 +101,10 @@ std::string line_plot_svg(const std::vector<PlotSeries>& series, const PlotOptio
   }
   o << "<rect x=\"" << left << "\" y=\"" << top << "\" width=\"" << pw << "\" height=\"" << ph
     << "\" fill=\"none\" stroke=\"#333\"/>\n";
-  o << "<text x=\"" << left + pw / 2 << "\" y=\"" << H - 12 << "\" text-anchor=\"middle\">" << escape(opt.x_label)
+  o << "<text x=\"" << left + pw / 2 << "\" y=\"" << H - 12 << "\" text-anchor=\"middle\">" << escape_markup(opt.x_label)
     << "</text>\n";
   o << "<text transform=\"translate(16," << top + ph / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
-    << escape(opt.y_label) << "</text>\n";
+    << escape_markup(opt.y_label) << "</text>\n";
   // Series: one polyline per run of drawable points.
   for (const auto& s : series) {
     std::ostringstream run;
@@ -145,7 +134,7 @@ std::string line_plot_svg(const std::vector<PlotSeries>& series, const PlotOptio
       const double y = top + 14 + 16 * double(k);
       o << "<line x1=\"" << left + pw - 150 << "\" y1=\"" << y - 4 << "\" x2=\"" << left + pw - 130 << "\" y2=\""
         << y - 4 << "\" stroke=\"" << series[k].colour << "\" stroke-width=\"2\"/>\n";
-      o << "<text x=\"" << left + pw - 124 << "\" y=\"" << y << "\">" << escape(series[k].name) << "</text>\n";
+      o << "<text x=\"" << left + pw - 124 << "\" y=\"" << y << "\">" << escape_markup(series[k].name) << "</text>\n";
     }
   o << "</svg>\n";
   return o.str();

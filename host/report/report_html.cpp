@@ -1,4 +1,5 @@
 #include "report/report_html.h"
+#include "report/markup.h"
 
 #include <cmath>
 #include <fstream>
@@ -7,18 +8,6 @@
 namespace pneumo {
 
 namespace {
-
-std::string escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '&') out += "&amp;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
-  }
-  return out;
-}
 
 bool read_file(const std::string& path, std::string& bytes) {
   std::ifstream in(path, std::ios::binary);
@@ -52,7 +41,7 @@ void rows(const nlohmann::json& obj, const std::string& prefix, std::ostringstre
       continue;
     }
     if (it->is_array() && !it->empty() && it->front().is_object()) continue;   // tables of their own
-    o << "<tr><td>" << escape(key) << "</td><td>" << escape(cell(*it)) << "</td></tr>\n";
+    o << "<tr><td>" << escape_markup(key) << "</td><td>" << escape_markup(cell(*it)) << "</td></tr>\n";
   }
 }
 
@@ -60,12 +49,12 @@ void rows(const nlohmann::json& obj, const std::string& prefix, std::ostringstre
 void array_table(const nlohmann::json& arr, std::ostringstream& o) {
   if (!arr.is_array() || arr.empty() || !arr.front().is_object()) return;
   o << "<table><tr>";
-  for (auto it = arr.front().begin(); it != arr.front().end(); ++it) o << "<th>" << escape(it.key()) << "</th>";
+  for (auto it = arr.front().begin(); it != arr.front().end(); ++it) o << "<th>" << escape_markup(it.key()) << "</th>";
   o << "</tr>\n";
   for (const auto& row : arr) {
     o << "<tr>";
     for (auto it = arr.front().begin(); it != arr.front().end(); ++it)
-      o << "<td>" << escape(row.contains(it.key()) ? cell(row.at(it.key())) : "") << "</td>";
+      o << "<td>" << escape_markup(row.contains(it.key()) ? cell(row.at(it.key())) : "") << "</td>";
     o << "</tr>\n";
   }
   o << "</table>\n";
@@ -95,7 +84,7 @@ std::string base64(const std::string& bytes) {
 
 std::string report_html(const ReportContent& c) {
   std::ostringstream o;
-  o << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << escape(c.title)
+  o << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << escape_markup(c.title)
     << "</title>\n<style>\n"
        "body{font-family:sans-serif;margin:2em auto;max-width:1100px;color:#222}\n"
        "h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.6em}\n"
@@ -104,28 +93,28 @@ std::string report_html(const ReportContent& c) {
        "figure{display:inline-block;margin:.5em;vertical-align:top}figcaption{font-size:.9em;color:#555}\n"
        "img{max-width:100%;border:1px solid #ccc}.warn{color:#b00}\n"
        "</style></head><body>\n";
-  o << "<h1>" << escape(c.title) << "</h1>\n";
+  o << "<h1>" << escape_markup(c.title) << "</h1>\n";
   const nlohmann::json& m = c.metrics;
   if (m.is_object()) {
     o << "<p>";
     if (m.contains("converged"))
       o << (m["converged"].get<bool>() ? "Converged" : "<span class=\"warn\">Not converged</span>") << " ("
-        << escape(cell(m.value("stop_reason", nlohmann::json("")))) << "). ";
+        << escape_markup(cell(m.value("stop_reason", nlohmann::json("")))) << "). ";
     for (const char* key : {"anterior_rise_mm", "cavity_volume_ml", "inverted_tetrahedra", "pressure_mmhg"})
-      if (m.contains(key)) o << escape(key) << ": <b>" << escape(cell(m[key])) << "</b>. ";
+      if (m.contains(key)) o << escape_markup(key) << ": <b>" << escape_markup(cell(m[key])) << "</b>. ";
     o << "</p>\n";
   }
   if (m.contains("stage_seconds")) {
     o << "<h2>Timings</h2>\n<table><tr><th>stage</th><th>seconds</th></tr>\n";
     for (auto it = m["stage_seconds"].begin(); it != m["stage_seconds"].end(); ++it)
-      o << "<tr><td>" << escape(it.key()) << "</td><td>" << escape(cell(*it)) << "</td></tr>\n";
+      o << "<tr><td>" << escape_markup(it.key()) << "</td><td>" << escape_markup(cell(*it)) << "</td></tr>\n";
     o << "</table>\n";
   }
   if (!c.plots.empty()) {
     o << "<h2>Plots</h2>\n";
     for (const auto& p : c.plots) {
       const std::size_t at = p.svg.find("<svg");
-      o << "<figure>" << (at == std::string::npos ? "" : p.svg.substr(at)) << "<figcaption>" << escape(p.title)
+      o << "<figure>" << (at == std::string::npos ? "" : p.svg.substr(at)) << "<figcaption>" << escape_markup(p.title)
         << "</figcaption></figure>\n";
     }
   }
@@ -135,10 +124,10 @@ std::string report_html(const ReportContent& c) {
       std::string bytes;
       o << "<figure>";
       if (read_file(img.path, bytes) && !bytes.empty())
-        o << "<img alt=\"" << escape(img.title) << "\" src=\"data:image/png;base64," << base64(bytes) << "\">";
+        o << "<img alt=\"" << escape_markup(img.title) << "\" src=\"data:image/png;base64," << base64(bytes) << "\">";
       else
-        o << "<p class=\"warn\">missing: " << escape(img.path) << "</p>";
-      o << "<figcaption>" << escape(img.title) << "</figcaption></figure>\n";
+        o << "<p class=\"warn\">missing: " << escape_markup(img.path) << "</p>";
+      o << "<figcaption>" << escape_markup(img.title) << "</figcaption></figure>\n";
     }
   }
   if (m.is_object()) {
@@ -147,7 +136,7 @@ std::string report_html(const ReportContent& c) {
     o << "</table>\n";
     for (auto it = m.begin(); it != m.end(); ++it)
       if (it->is_array() && !it->empty() && it->front().is_object()) {
-        o << "<h3>" << escape(it.key()) << "</h3>\n";
+        o << "<h3>" << escape_markup(it.key()) << "</h3>\n";
         array_table(*it, o);
       }
   }
