@@ -50,6 +50,7 @@
 
 #include "cl/cl_runtime.h"
 #include "common/cpu_load.h"
+#include "common/explicit_update.h"
 #include "common/solver_cost.h"
 #include "core/log.h"
 #include "core/progress.h"
@@ -252,18 +253,9 @@ void BM_ExplicitStepCpu(benchmark::State& state, const Case& size, int threads) 
   ForceEvaluator eval(m);
   std::vector<Vec3> x = mc.x0, v = mc.v0, f;
   const double dt = mc.dt_s;
-  // The plain symplectic Euler update of solve_explicit (v += dt f/m, held axes zeroed, x += dt v), one pass.
   const auto step = [&] {
     eval.evaluate(mc.model, x, v, f);
-#pragma omp parallel for schedule(static)
-    for (int64_t n = 0; n < N; ++n) {
-      Vec3 vn = v[n] + (dt / m.mass_kg[n]) * f[n];
-      if (const uint8_t h = m.hold[n])
-        for (int a = 0; a < 3; ++a)
-          if (h & (1 << a)) vn[a] = 0.0;
-      v[n] = vn;
-      x[n] += dt * vn;
-    }
+    bench::explicit_update(m, dt, f, x, v);
   };
   double seconds = 0.0;
   with_threads(threads, [&] {

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "common/cpu_load.h"
+#include "common/explicit_update.h"
 #include "common/solver_cost.h"
 #include "common/warp_cost.h"
 #include "render/camera_model.h"
@@ -96,19 +97,9 @@ json measure_forces_and_steps(BenchContext& ctx, const BenchCase& c, const Devic
       evaluate();   // allocates the per-element scratch
       forces_k = batch(ctx, evaluate);
       forces_s = time_reps(reps(ctx), 0, [&] { for (int i = 0; i < forces_k; ++i) evaluate(); });
-      // The plain symplectic Euler update of solve_explicit, one pass (as bench_solver.cpp).
-      const int64_t n_nodes = m.node_count();
       const auto step = [&] {
         eval.evaluate(model, x, v, f);
-#pragma omp parallel for schedule(static)
-        for (int64_t n = 0; n < n_nodes; ++n) {
-          Vec3 vn = v[n] + (dt / m.mass_kg[n]) * f[n];
-          if (const uint8_t h = m.hold[n])
-            for (int a = 0; a < 3; ++a)
-              if (h & (1 << a)) vn[a] = 0.0;
-          v[n] = vn;
-          x[n] += dt * vn;
-        }
+        bench::explicit_update(m, dt, f, x, v);
       };
       steps_k = batch(ctx, step);
       steps_s = time_reps(reps(ctx), 0, [&] { for (int i = 0; i < steps_k; ++i) step(); });
