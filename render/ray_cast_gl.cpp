@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <stdexcept>
 
 #include "core/error.h"
@@ -27,12 +28,16 @@ GLuint make_texture(GLenum target, GLint filter) {
   return t;
 }
 
-// A key for what the occupancy grid depends on besides the volume.
-std::string occupancy_key(const RenderSettings& s) {
-  std::string k = s.hide_exterior_air ? "x" : "-";
-  for (const auto& p : s.tf.opacity) k += std::to_string(p[0]) + ":" + std::to_string(p[1]) + ";";
-  return k;
-}
+// What the occupancy grid depends on besides the volume, compared exactly (a rounded text key would
+// take an opacity of 1e-7 for 0 and keep blocks skipped that must be drawn).
+struct OccupancyKey {
+  bool hide_exterior_air = false;
+  decltype(TransferFunction::opacity) opacity;
+  bool operator==(const OccupancyKey& o) const {
+    return hide_exterior_air == o.hide_exterior_air && opacity == o.opacity;
+  }
+};
+OccupancyKey occupancy_key(const RenderSettings& s) { return {s.hide_exterior_air, s.tf.opacity}; }
 
 }  // namespace
 
@@ -49,7 +54,7 @@ struct GlRayCaster::Impl {
   float hu_scale = 1.0f;
   std::string hu_format = "none";
   BlockRanges ranges;
-  std::string occ_key;
+  std::optional<OccupancyKey> occ_key;   // none: no grid built for the current volume
 
   explicit Impl(GlContext& c) : ctx((c.make_current(), c)) {
     program(true, true, false);  // compile the common variant now: shader errors surface here
@@ -103,8 +108,8 @@ struct GlRayCaster::Impl {
   }
 
   void upload_occupancy(const RenderSettings& s) {
-    const std::string key = occupancy_key(s);
-    if (key == occ_key) return;
+    const OccupancyKey key = occupancy_key(s);
+    if (occ_key && *occ_key == key) return;
     const OccupancyGrid occ = occupancy(ranges, s.tf, s.hide_exterior_air);
     const gl::Api& g = gl::api();
     if (occ_tex) g.DeleteTextures(1, &occ_tex);
@@ -168,7 +173,7 @@ void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
   m.geometry = v.geometry;
   m.w2i = v.world_to_index();
   m.ranges = block_ranges(v);
-  m.occ_key.clear();
+  m.occ_key.reset();
   m.have_volume = true;
   log::debug("GL ray caster: volume " + std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" +
              std::to_string(d[2]) + " as " + m.hu_format);

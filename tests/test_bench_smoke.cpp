@@ -73,11 +73,11 @@ TEST(BenchSmoke, QuickRunWritesEverySectionWithFiniteNumbers) {
 
   // Speed against accuracy: every solver ran, errors against the reference are there, a front exists.
   const json& sa = doc["speed_accuracy"];
-  std::set<std::string> solvers;
+  std::set<std::string> solvers;   // those with at least one run that reached an error figure
   int on_front = 0;
   for (const json& run : sa["runs"]) {
-    solvers.insert(run["solver"].get<std::string>());
     if (run["rms_error_mm"].is_number()) {
+      solvers.insert(run["solver"].get<std::string>());
       EXPECT_GE(run["rms_error_mm"].get<double>(), 0);
       EXPECT_TRUE(run["warp_mad_hu"].is_number());
       EXPECT_GT(run["skin"]["compared_points"].get<int>(), 0);

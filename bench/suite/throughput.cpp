@@ -10,6 +10,7 @@
 #include "common/explicit_update.h"
 #include "common/solver_cost.h"
 #include "common/warp_cost.h"
+#include "pipeline/render_scene.h"
 #include "render/camera_model.h"
 #include "render/gl_context.h"
 #include "render/ray_cast_gl.h"
@@ -170,16 +171,6 @@ ViewCamera bench_camera(const BenchCase& c, int width, int height) {
   return make_view_camera(look_at_pose(centre + Vec3(0, 400, 0), centre, Vec3(0, 0, 1)), o, width, height);
 }
 
-RenderSettings bench_render_settings(const BenchCase& c) {
-  const SceneRender& r = c.scene.render;
-  RenderSettings s;
-  s.tf = scene_transfer_function(r);
-  s.step_mm = r.step_fraction * c.ct.geometry().spacing_mm.minCoeff();
-  s.show_labels = r.show_labels;
-  s.label_opacity = r.label_opacity;
-  s.light_falloff_mm = r.light_falloff_mm;
-  return s;
-}
 
 }  // namespace
 
@@ -207,7 +198,7 @@ json measure_case_throughput(BenchContext& ctx, const BenchCase& c, int pipeline
   }();
   const int width = ctx.quick() ? 128 : c.scene.render.width, height = ctx.quick() ? 96 : c.scene.render.height;
   const ViewCamera camera = bench_camera(c, width, height);
-  const RenderSettings settings = bench_render_settings(c);
+  const RenderSettings settings = settings_from_scene(c.scene.render, c.ct.geometry());
   std::unique_ptr<GlRayCaster> gl;
   std::string gl_renderer;
   try {

@@ -85,6 +85,9 @@ struct Mesh {
 /// Young's modulus per tetrahedron comes from `young_pa_for(role, label)`.
 Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const std::function<double(Role, int)>& young_pa_for);
 
+/// u = x − x₀ per node (metres): what deformation.bin, checkpoints and the warp carry.
+std::vector<Vec3> displacements(const Mesh& m, const std::vector<Vec3>& x);
+
 /// The mesh of a scene's roles, with its material assigned.
 Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene);
 

@@ -13,6 +13,12 @@ namespace pneumo {
 
 const char* part_name(Part p) { return p == Part::Wall ? "wall" : "viscera"; }
 
+std::vector<Vec3> displacements(const Mesh& m, const std::vector<Vec3>& x) {
+  std::vector<Vec3> u(x.size());
+  for (std::size_t n = 0; n < x.size(); ++n) u[n] = x[n] - m.rest_m[n];
+  return u;
+}
+
 namespace {
 
 constexpr int kParts = 2;

@@ -29,20 +29,6 @@ std::string show(const Vec3& v) {
   return b;
 }
 
-RenderSettings settings_from_scene(const SceneRender& r, const Geometry& g) {
-  RenderSettings s;
-  s.tf = scene_transfer_function(r);
-  s.step_mm = r.step_fraction * g.spacing_mm.minCoeff();  // §8: at most half the smallest spacing
-  s.jitter = r.jitter;
-  s.show_labels = r.show_labels;
-  s.label_opacity = r.label_opacity;
-  s.ambient = r.ambient;
-  s.diffuse = r.diffuse;
-  s.specular = r.specular;
-  s.shininess = r.shininess;
-  s.light_falloff_mm = r.light_falloff_mm;
-  return s;
-}
 
 // The GL ray caster or the CPU reference behind one call.
 class Renderer {
@@ -85,6 +71,21 @@ nlohmann::json pose_json(const ViewCamera& c) {
 }
 
 }  // namespace
+
+RenderSettings settings_from_scene(const SceneRender& r, const Geometry& g) {
+  RenderSettings s;
+  s.tf = scene_transfer_function(r);
+  s.step_mm = r.step_fraction * g.spacing_mm.minCoeff();  // §8: at most half the smallest spacing
+  s.jitter = r.jitter;
+  s.show_labels = r.show_labels;
+  s.label_opacity = r.label_opacity;
+  s.ambient = r.ambient;
+  s.diffuse = r.diffuse;
+  s.specular = r.specular;
+  s.shininess = r.shininess;
+  s.light_falloff_mm = r.light_falloff_mm;
+  return s;
+}
 
 bool ffmpeg_available() { return std::system("command -v ffmpeg >/dev/null 2>&1") == 0; }
 
@@ -136,8 +137,7 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Vol
   const fs::path out(opt.out_dir);
   const fs::path deformed_labels = out / "deformed_labels.nii.gz";
   const PointMapFn map = opt.map_point ? opt.map_point : identity_point_map();
-  scene_transfer_function(r);
-  const RenderVolume volume = RenderVolume::from(ct, labels);
+  RenderVolume volume = RenderVolume::from(ct, labels);
   const RenderSettings s = settings_from_scene(r, volume.geometry);
 
   // Poses first: every bad one is reported before any rendering.
@@ -235,9 +235,9 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Vol
   if (exterior) {
     // The abdomen from outside with CT-Air: air connected to the grid's faces is hidden, so what
     // shows is the gas inside the body (the insufflated cavity, bowel gas, lungs) as a surface.
-    RenderVolume ext = volume;
-    ext.mark_exterior_air();
-    renderer.set_volume(ext);
+    // Last of all views: the volume is marked in place, not copied.
+    volume.mark_exterior_air();
+    renderer.set_volume(volume);
     RenderSettings es = s;
     es.tf = preset_transfer_function(RenderPreset::CtAir);
     es.hide_exterior_air = true;

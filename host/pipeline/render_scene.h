@@ -20,6 +20,7 @@
 #include "io/volume.h"
 #include "render/gl_context.h"
 #include "render/poses.h"
+#include "render/render_settings.h"
 #include "scene/scene.h"
 
 namespace pneumo {
@@ -47,6 +48,10 @@ RenderRun render_scene(const Scene& scene, const RenderOptions& options);
 /// carries what the report names (the volumes' paths, whether they are deformed).
 RenderRun render_volumes(const Scene& scene, const RenderOptions& options, const Volume& ct, const Volume* labels,
                          RenderRun run);
+
+/// The ray caster's settings from a scene's render section, for a volume on grid `g` (the step is
+/// render.step_fraction of its smallest spacing).
+RenderSettings settings_from_scene(const SceneRender& r, const Geometry& g);
 
 /// Whether ffmpeg is on PATH, and frames frame_0001.png … in `frame_dir` → `mp4` (H.264, 25 frames/s,
 /// written beside and renamed; false with a warning when ffmpeg fails).

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <climits>
 #include <memory>
+#include <optional>
 #include <filesystem>
 #include <fstream>
 
@@ -11,6 +12,7 @@
 #include "core/log.h"
 #include "core/units.h"
 #include "evaluate/landmarks.h"
+#include "io/volume_io.h"
 #include "mesh/deformation_file.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/simulate.h"
@@ -55,12 +57,6 @@ void prepare_folder(const RunOptions& o) {
   for (const char* f : kRunFolders) fs::remove_all(out / f, ec);
 }
 
-std::vector<Vec3> displacements(const Mesh& m, const std::vector<Vec3>& x) {
-  std::vector<Vec3> u(x.size());
-  for (std::size_t n = 0; n < x.size(); ++n) u[n] = x[n] - m.rest_m[n];
-  return u;
-}
-
 nlohmann::json read_json(const std::string& path) {
   std::ifstream is(path);
   const auto j = nlohmann::json::parse(is, nullptr, false);
@@ -68,10 +64,6 @@ nlohmann::json read_json(const std::string& path) {
   return j;
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream is(path);
-  return std::string((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
-}
 
 }  // namespace
 
@@ -130,7 +122,16 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
 
   // Warp, then render with the warp's point mapping (ports travel with the skin).
   log::info("stage 2/4: warp");
-  const WarpedCase w = warp_scene(scene, o.out_dir);
+  // The simulation's roles, mesh and shape, not rebuilt; only the input volumes are read again (the
+  // roles keep a padded float copy, the outputs need the originals' grids and types).
+  Deformation solved;
+  solved.displacement_m = displacements(sim.mesh, sim.result.x);
+  solved.pressure_pa = sim.result.final_pressure_pa;
+  solved.converged = sim.result.converged;
+  std::optional<Volume> input_labels;
+  if (!scene.inputs.labels.empty()) input_labels = read_volume(scene.inputs.labels);
+  const WarpedCase w = warp_solved(scene, read_volume(scene.require_ct()), std::move(input_labels),
+                                   std::move(sim.roles), std::move(sim.mesh), std::move(solved));
   write_warp(scene, w, o.out_dir);
   const PointMap point_map = w.point_map();
   const PointMapFn map = [&point_map](const Vec3& p) -> Vec3 { return point_map.to_deformed(p).point_mm; };
@@ -141,7 +142,18 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   ro.out_dir = o.out_dir;
   ro.backend = o.backend;
   ro.map_point = map;
-  const RenderRun rendered = render_scene(scene, ro);
+  // The warped volumes from memory, not read back from the files just written.
+  RenderRun what;
+  what.deformed = true;
+  what.ct_path = (out / "deformed_ct.nii.gz").string();
+  const Volume deformed_ct = deformed_ct_volume(w);
+  std::optional<Volume> deformed_labels;
+  if (w.labels) {
+    deformed_labels = deformed_label_volume(w, scene.output.cavity_label);
+    what.labels_path = (out / "deformed_labels.nii.gz").string();
+  }
+  const RenderRun rendered =
+      render_volumes(scene, ro, deformed_ct, deformed_labels ? &*deformed_labels : nullptr, what);
   const double seconds_render = seconds_since(t_render);
 
   // Report: landmarks, plots, metrics (complete), report.html last.
@@ -153,9 +165,8 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   ReportContent rc;
   rc.title = "pneumo: " + (scene.name.empty() ? scene.path : scene.name);
   rc.scene = scene.echo();
-  rc.plots.push_back({"Convergence", read_text((out / "convergence.svg").string())});
-  if (!sim.pressure_curve.empty())
-    rc.plots.push_back({"Pressure-volume curve", read_text((out / "pressure_volume.svg").string())});
+  rc.plots.push_back({"Convergence", convergence_plot_svg(sim.result)});
+  if (!sim.pressure_curve.empty()) rc.plots.push_back({"Pressure-volume curve", pressure_curve_plot_svg(sim.pressure_curve)});
   rc.images.push_back({"Roles: wall orange, viscera green, fixed blue", (out / "roles.png").string()});
   if (fs::exists(out / "slices_before_after.png"))
     rc.images.push_back({"Before and after (axial, coronal, sagittal)", (out / "slices_before_after.png").string()});

@@ -281,8 +281,7 @@ void write_simulation(const Scene& scene, const Simulation& sim, const std::stri
   }
   // The solved shape for `pneumo warp` and later stages (deformation_file.h).
   Deformation def;
-  def.displacement_m.resize(sim.result.x.size());
-  for (std::size_t n = 0; n < sim.result.x.size(); ++n) def.displacement_m[n] = sim.result.x[n] - sim.mesh.rest_m[n];
+  def.displacement_m = displacements(sim.mesh, sim.result.x);
   def.pressure_pa = sim.result.final_pressure_pa;
   def.converged = sim.result.converged;
   write_deformation(path("deformation.bin"), sim.mesh, def);

@@ -5,7 +5,8 @@
 
 #include "core/log.h"
 #include "core/units.h"
-#include "io/volume_io.h"
+#include "io/volume.h"
+#include "roles/pad.h"
 #include "pipeline/render_scene.h"
 #include "warp/point_map.h"
 #include "warp/warp.h"
@@ -17,8 +18,7 @@ namespace fs = std::filesystem;
 
 Timelapse::Timelapse(const Scene& scene, const Simulation& sim, const std::string& out_dir, GlBackend backend)
     : scene_(scene), preview_(scene), sim_(sim), out_dir_(out_dir), backend_(backend),
-      ct_(read_volume(scene.require_ct())) {
-  if (!scene.inputs.labels.empty()) labels_ = std::make_unique<Volume>(read_volume(scene.inputs.labels));
+      ct_grid_(unpadded_geometry(sim.roles.geometry, sim.roles.pad)), labels_(!scene.inputs.labels.empty()) {
   SceneRender& r = preview_.render;
   r.paths.clear();
   if (!r.cameras.empty()) {
@@ -35,25 +35,23 @@ Timelapse::Timelapse(const Scene& scene, const Simulation& sim, const std::strin
 
 void Timelapse::frame(const SolverSnapshot& snapshot) {
   const Mesh& m = sim_.mesh;
-  std::vector<Vec3> u(m.rest_m.size());
-  for (std::size_t n = 0; n < u.size(); ++n) u[n] = snapshot.x[n] - m.rest_m[n];
-  const WarpMesh wm = make_warp_mesh(m, u);
+  const WarpMesh wm = make_warp_mesh(m, displacements(m, snapshot.x));
   WarpSource src;
   src.ct_hu = sim_.roles.ct.data<float>();
   src.labels = labels_ ? sim_.roles.label.data() : nullptr;
   src.roles = sim_.roles.role.data();
   WarpBox box;
   box.lo = sim_.roles.pad.lo;
-  box.dims = ct_.geometry().dims;
+  box.dims = ct_grid_.dims;
   WarpOptions wo;
   wo.cavity_label = uint16_t(scene_.output.cavity_label);
   const WarpResult w = warp_on_device(scene_.device, wm, src, box, wo);
 
-  Volume ct(ct_.geometry(), VoxelType::Float32);
+  Volume ct(ct_grid_, VoxelType::Float32);
   std::copy(w.ct_hu.begin(), w.ct_hu.end(), ct.data<float>());
   std::unique_ptr<Volume> labels;
   if (labels_) {
-    labels = std::make_unique<Volume>(ct_.geometry(), VoxelType::UInt16);
+    labels = std::make_unique<Volume>(ct_grid_, VoxelType::UInt16);
     std::copy(w.labels.begin(), w.labels.end(), labels->data<uint16_t>());
   }
   const PointMap point_map(wm, sim_.roles.role.data());

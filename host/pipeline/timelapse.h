@@ -7,7 +7,6 @@
 #include <memory>
 #include <string>
 
-#include "io/volume.h"
 #include "pipeline/simulate.h"
 #include "render/gl_context.h"
 #include "scene/scene.h"
@@ -16,7 +15,7 @@ namespace pneumo {
 
 class Timelapse {
  public:
-  /// Reads the input CT (and labels) once; `sim` (roles, mesh) must outlive the timelapse.
+  /// `sim` (roles, mesh) must outlive the timelapse; the frames are warped from its roles' volumes.
   Timelapse(const Scene& scene, const Simulation& sim, const std::string& out_dir, GlBackend backend);
   /// Warps through positions x (m) and renders one frame of each preview view.
   void frame(const SolverSnapshot& snapshot);
@@ -29,8 +28,8 @@ class Timelapse {
   const Simulation& sim_;
   std::string out_dir_;
   GlBackend backend_;
-  Volume ct_;
-  std::unique_ptr<Volume> labels_;
+  Geometry ct_grid_;      // the input CT's grid, inside the roles' padded one
+  bool labels_;
   int frames_ = 0;
 };
 

@@ -74,25 +74,36 @@ DeformedMesh load_deformed_mesh(const Scene& scene, const std::string& sim_dir) 
 
 WarpedCase warp_scene(const Scene& scene, const std::string& sim_dir) {
   read_metrics(sim_dir);   // a finished simulation, before reading a large CT for nothing
+  Volume ct = read_volume(scene.require_ct());
+  std::optional<Volume> labels;
+  if (!scene.inputs.labels.empty()) labels = read_volume(scene.inputs.labels);
+  RoleVolume roles = assign_roles(scene, ct, labels ? &*labels : nullptr);
+  Mesh mesh = build_scene_mesh(VoxelRoles{roles.geometry, roles.role.data(), roles.label.data()}, scene);
+  Deformation deformation = read_deformation(in_dir(sim_dir, "deformation.bin"), mesh);
+  const double scene_pa = units::mmhg_to_pa(scene.load.pressure_mmhg);
+  if (scene.load.pressure_curve_mmhg.empty() && std::abs(deformation.pressure_pa - scene_pa) > 1e-6 * scene_pa)
+    log::warn(sim_dir + ": the deformation was solved at " +
+              std::to_string(deformation.pressure_pa / units::kPaPerMmHg) + " mmHg, the scene now asks for " +
+              std::to_string(scene.load.pressure_mmhg) + " mmHg; warping the solved shape");
+  if (!deformation.converged) log::warn(sim_dir + ": the simulation did not converge; warping its last shape");
+  return warp_solved(scene, std::move(ct), std::move(labels), std::move(roles), std::move(mesh),
+                     std::move(deformation));
+}
+
+WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labels, RoleVolume roles, Mesh mesh,
+                       Deformation deformation) {
   WarpedCase w;
-  w.ct = read_volume(scene.require_ct());
-  if (!scene.inputs.labels.empty()) w.labels = read_volume(scene.inputs.labels);
-  w.roles = assign_roles(scene, w.ct, w.labels ? &*w.labels : nullptr);
+  w.ct = std::move(ct);
+  w.labels = std::move(labels);
+  w.roles = std::move(roles);
+  w.mesh = std::move(mesh);
+  w.deformation = std::move(deformation);
   const uint16_t cavity = uint16_t(scene.output.cavity_label);
   if (w.labels)
     for (uint16_t l : w.roles.label)
       if (l == cavity)
         throw file_error(scene.inputs.labels, "already uses label " + std::to_string(cavity) +
                                                   ", the cavity's id; choose a free one with output.cavity_label");
-
-  w.mesh = build_scene_mesh(VoxelRoles{w.roles.geometry, w.roles.role.data(), w.roles.label.data()}, scene);
-  w.deformation = read_deformation(in_dir(sim_dir, "deformation.bin"), w.mesh);
-  const double scene_pa = units::mmhg_to_pa(scene.load.pressure_mmhg);
-  if (scene.load.pressure_curve_mmhg.empty() && std::abs(w.deformation.pressure_pa - scene_pa) > 1e-6 * scene_pa)
-    log::warn(sim_dir + ": the deformation was solved at " +
-              std::to_string(w.deformation.pressure_pa / units::kPaPerMmHg) + " mmHg, the scene now asks for " +
-              std::to_string(scene.load.pressure_mmhg) + " mmHg; warping the solved shape");
-  if (!w.deformation.converged) log::warn(sim_dir + ": the simulation did not converge; warping its last shape");
   w.warp_mesh = make_warp_mesh(w.mesh, w.deformation.displacement_m);
 
   WarpSource src;

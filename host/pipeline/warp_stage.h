@@ -54,6 +54,11 @@ DeformedMesh load_deformed_mesh(const Scene& scene, const std::string& sim_dir);
 /// output.cavity_label.
 WarpedCase warp_scene(const Scene& scene, const std::string& sim_dir);
 
+/// The warp of a case whose roles, mesh and solved deformation are already in hand (`pneumo run`
+/// passes its simulation's, instead of rebuilding them): `ct` and `labels` are the input volumes.
+WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labels, RoleVolume roles, Mesh mesh,
+                       Deformation deformation);
+
 /// The deformed CT in the input's voxel type where it can hold HU (int16, int32 rounded to the
 /// nearest HU; float32, float64 as computed), float32 otherwise (unsigned or 8-bit types).
 Volume deformed_ct_volume(const WarpedCase& w);

@@ -43,6 +43,13 @@ Geometry padded_geometry(const Geometry& g, const PadVoxels& pad) {
   return out;
 }
 
+Geometry unpadded_geometry(const Geometry& padded, const PadVoxels& pad) {
+  Geometry out = padded;
+  for (int a = 0; a < 3; ++a) out.dims[a] = padded.dims[a] - pad.lo[a] - pad.hi[a];
+  out.origin_mm = padded.to_world(Vec3(double(pad.lo[0]), double(pad.lo[1]), double(pad.lo[2])));
+  return out;
+}
+
 Volume pad_volume(const Volume& v, const PadVoxels& pad, double fill) {
   Volume out(padded_geometry(v.geometry(), pad), v.type());
   dispatch_voxel_type(v.type(), const_cast<void*>(v.raw()), [&](auto* src) {

@@ -30,6 +30,8 @@ struct PadVoxels {
 PadVoxels pad_voxels(const Geometry& g, const PadMm& mm);
 /// The grid after padding: dims grown, origin moved by -lo voxels, spacing and direction kept.
 Geometry padded_geometry(const Geometry& g, const PadVoxels& pad);
+/// The inverse: the original grid inside a padded one.
+Geometry unpadded_geometry(const Geometry& padded, const PadVoxels& pad);
 
 /// The padded copy of `src` (dims `dims`, i fastest), converted to TOut, `fill` in the new voxels.
 template <class TOut, class TIn>

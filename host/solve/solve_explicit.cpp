@@ -13,6 +13,7 @@ SolveResult solve_explicit(const Mesh& m, const SolveOptions& opt, std::vector<V
   ForceEvaluator eval(m);
   std::vector<Vec3> v(m.node_count(), Vec3::Zero()), f;
   ForceModel model = opt.forces;
+  const std::string advice = detail::dt_advice(dt, r.dt_stable_s);
   int64_t step = 0;
   double residual = INFINITY;
   std::string reason;
@@ -24,7 +25,7 @@ SolveResult solve_explicit(const Mesh& m, const SolveOptions& opt, std::vector<V
     detail::apply_holds(m, v);
     for (int64_t n = 0; n < m.node_count(); ++n) x[n] += dt * v[n];
     ++step;
-    reason = mon.check_dynamic(step, t + dt, model.pressure_pa, f, x, v, detail::dt_advice(dt, r.dt_stable_s), &residual);
+    reason = mon.check_dynamic(step, t + dt, model.pressure_pa, f, x, v, advice, &residual);
     if (!reason.empty()) break;
   }
   r.final_pressure_pa = model.pressure_pa;

@@ -32,6 +32,7 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
   // alone would otherwise look like a diverging loop.
   const double a_floor = detail::newmark_acceleration_floor(m, mon);
   ForceModel model = opt.forces;
+  const std::string advice = detail::dt_advice(dt, r.dt_stable_s);
   int64_t step = 0;
   double residual = INFINITY;
   std::string reason;
@@ -67,7 +68,7 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
     }
     detail::apply_holds(m, v);
     ++step;
-    reason = mon.check_dynamic(step, t_next, model.pressure_pa, f, x, v, detail::dt_advice(dt, r.dt_stable_s), &residual);
+    reason = mon.check_dynamic(step, t_next, model.pressure_pa, f, x, v, advice, &residual);
     if (!reason.empty()) break;
   }
   r.final_pressure_pa = model.pressure_pa;

@@ -111,6 +111,7 @@ SolveResult explicit_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& op
   set_args(step_k, d.eval.positions(), d.eval.velocities(), d.eval.forces(), d.inv_mass, d.hold, float(dt), d.n);
   ForceModel model = opt.forces;
   std::vector<Vec3> cache;
+  const std::string advice = detail::dt_advice(dt, r.dt_stable_s);
   int64_t step = 0;
   double residual = INFINITY;
   std::string reason;
@@ -123,7 +124,7 @@ SolveResult explicit_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& op
     if (step % opt.monitor_every != 0 && step != opt.max_steps) continue;
     const auto o = d.observe(d.eval.positions(), d.eval.velocities());
     reason = mon.check_dynamic(step, t + dt, model.pressure_pa, o.max_free_force / mon.reference_load(),
-                               o.max_displacement, o.max_speed, detail::dt_advice(dt, r.dt_stable_s),
+                               o.max_displacement, o.max_speed, advice,
                                lazy_positions(d, d.eval.positions(), cache), &residual);
     if (!reason.empty()) break;
   }
@@ -157,6 +158,7 @@ SolveResult newmark_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt
   set_args(commit, xp, vp, a, d.hold, x, v, float(dt), beta, gamma, d.n);
   ForceModel model = opt.forces;
   std::vector<Vec3> cache;
+  const std::string advice = detail::dt_advice(dt, r.dt_stable_s);
   int64_t step = 0, evaluations = 0;
   double residual = INFINITY;
   std::string reason;
@@ -182,7 +184,7 @@ SolveResult newmark_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt
     if (step % opt.monitor_every != 0 && step != opt.max_steps) continue;
     const auto o = d.observe(x, v);
     reason = mon.check_dynamic(step, t_next, model.pressure_pa, o.max_free_force / mon.reference_load(),
-                               o.max_displacement, o.max_speed, detail::dt_advice(dt, r.dt_stable_s),
+                               o.max_displacement, o.max_speed, advice,
                                lazy_positions(d, x, cache), &residual);
     if (!reason.empty()) break;
   }

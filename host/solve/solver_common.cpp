@@ -179,7 +179,7 @@ bool Monitor::record(int64_t step, double time_s, double pressure_pa, double res
     if (rate < 0.0 && std::isfinite(rate))
       eta = (std::log(opt_.residual_tolerance) - std::log(residual)) / rate * seconds_per_step;
   }
-  progress_.update(step, detail, eta);
+  if (opt_.progress) progress_.update(step, detail, eta);
   if (opt_.on_snapshot && opt_.snapshot_every_steps > 0 && step >= next_snapshot_) {
     opt_.on_snapshot(SolverSnapshot{step, time_s, pressure_pa, positions()});
     next_snapshot_ = (step / opt_.snapshot_every_steps + 1) * opt_.snapshot_every_steps;
@@ -231,7 +231,7 @@ void Monitor::finish(const std::vector<Vec3>& x, const std::vector<Vec3>& v, int
   char detail[160];
   std::snprintf(detail, sizeof detail, "%s after %lld steps, residual %.2e", stop_reason.c_str(), (long long)steps,
                 residual);
-  progress_.finish(detail);
+  if (opt_.progress) progress_.finish(detail);
 }
 
 }  // namespace pneumo::detail

@@ -79,7 +79,9 @@ WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource
                        const WarpOptions& opt) {
   const int64_t T = mesh.tet_count();
   const int64_t n_src = mesh.grid.voxel_count(), n_out = box.voxel_count();
-  if (T >= INT_MAX) throw InputError("the warp handles at most 2^31 − 2 tetrahedra");
+  // The kernel indexes 8 values per tetrahedron in int.
+  if (T >= INT_MAX / 8) throw InputError("the warp handles at most 2^28 tetrahedra");
+  ocl::require_features(ctx.info(), kLocal, 0);
   const bool has_labels = src.labels != nullptr;
   // Source CT, roles and labels; owner, CT, labels and outcome per output voxel; tetrahedra.
   const uint64_t src_bytes = uint64_t(n_src) * (4 + 1 + (has_labels ? 2 : 0));
