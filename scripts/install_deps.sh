@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs every build and run dependency of pneumo from Debian 12 packages.
 # Idempotent and non-interactive; run as root (or with sudo available).
+#   --peers  also what the peer tools in ../shared/peers need (VTK, SciPy, ITK, GLEW), for bench/peers/.
 set -euo pipefail
 
 packages=(
@@ -21,6 +22,9 @@ packages=(
   # tests and benchmarks
   libgtest-dev googletest libbenchmark-dev
 )
+if [ "${1:-}" = "--peers" ]; then
+  packages+=(python3-numpy python3-scipy python3-vtk9 libinsighttoolkit5-dev libglew-dev)
+fi
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi

@@ -3,6 +3,7 @@
 
 #include "cli/commands.h"
 #include "suite/bench_suite.h"
+#include "suite/peer_warp.h"
 
 namespace pneumo::cli {
 
@@ -17,7 +18,21 @@ Run add_bench(CLI::App& app) {
   cmd->add_option("--markdown", o->markdown_path, "Write the results as Markdown, and the speed-accuracy plot beside it (.svg)");
   cmd->add_option("--real-ct", o->real_ct_scene, "Scene of the real CT (skipped with a note when it or its CT is missing)")
       ->capture_default_str();
-  return [o] {
+  auto peer = std::make_shared<bench::PeerWarpOptions>();
+  cmd->add_option("--peer-warp", peer->data_dir,
+                  "Instead of the suite: warp the peers' phantom (DIR/phantom.mhd from ../shared/peers/phantom.py) "
+                  "through their mesh and lift (vtk_tetwarp.py) on the CPU and OpenCL, for bench/peers/compare_warp.sh");
+  cmd->add_option("--peer-out", peer->out_dir, "Where --peer-warp writes (default DIR/pneumo)");
+  cmd->add_option("--node-step", peer->node_step, "--peer-warp: voxels between mesh nodes (vtk_tetwarp.py --node-step)")
+      ->capture_default_str();
+  cmd->add_option("--amp", peer->amp_mm, "--peer-warp: the lift's amplitude, mm (vtk_tetwarp.py --amp)")
+      ->capture_default_str();
+  return [o, peer] {
+    if (!peer->data_dir.empty()) {
+      const nlohmann::json doc = bench::run_peer_warp(*peer);
+      std::printf("%s\n", doc.dump(2).c_str());
+      return 0;
+    }
     const nlohmann::json doc = bench::run_bench(*o);
     if (o->json_path.empty() && o->markdown_path.empty()) std::printf("%s\n", doc.dump(2).c_str());
     else std::fprintf(stderr, "[bench] done in %.0f s\n", doc["wall_time_s"].get<double>());
