@@ -49,6 +49,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cl/cl_runtime.h"
+#include "core/stopwatch.h"
 #include "common/cpu_load.h"
 #include "common/explicit_update.h"
 #include "common/solver_cost.h"
@@ -197,8 +198,6 @@ void mesh_counters(benchmark::State& state, const Mesh& m) {
   state.counters["nodes"] = double(m.node_count());
   state.counters["springs"] = double(m.springs.size());
 }
-
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // ---- contention: CPU used by other processes while a benchmark ran (Linux /proc; −1 elsewhere) ----
 

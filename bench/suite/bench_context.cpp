@@ -74,10 +74,6 @@ void with_threads(int threads, const std::function<void()>& fn) {
   omp_set_num_threads(before);
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 Summary time_reps(int reps, int warmups, const std::function<void()>& fn) {
   for (int w = 0; w < warmups; ++w) fn();
   std::vector<double> s;

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cl/cl_runtime.h"
+#include "core/stopwatch.h"
 #include "common/stats.h"
 
 namespace pneumo::bench {
@@ -54,6 +55,5 @@ void with_threads(int threads, const std::function<void()>& fn);
 /// Times `reps` calls of `fn` (after `warmups` untimed ones): seconds per call, summarised.
 Summary time_reps(int reps, int warmups, const std::function<void()>& fn);
 
-double seconds_since(std::chrono::steady_clock::time_point t0);
 
 }  // namespace pneumo::bench

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "core/atomic_file.h"
+#include "core/stopwatch.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "io/volume_io.h"
@@ -26,8 +27,6 @@ namespace {
 
 // MetaImage positions are LPS+, pneumo's RAS+: x and y change sign (io/metaimage_io.cpp).
 const Vec3 kLpsFlip(-1.0, -1.0, 1.0);
-
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // vtk_tetwarp.py tet_mesh(): corners 0..7 of a cube with bit 0 = +x, bit 1 = +y, bit 2 = +z; pattern A where i+j+k is
 // even (central tetrahedron {0,3,5,6}), B where odd ({1,2,4,7}); tetrahedron type outermost, then cubes with i slowest

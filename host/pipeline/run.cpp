@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "core/atomic_file.h"
+#include "core/stopwatch.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/units.h"
@@ -26,10 +27,6 @@ namespace pneumo {
 namespace {
 
 namespace fs = std::filesystem;
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// What a run writes at the top of its folder, and the folders it fills: an earlier run's copies are
 /// removed before a forced run, so nothing stale sits beside the new results.

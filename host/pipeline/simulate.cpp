@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/atomic_file.h"
+#include "core/stopwatch.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/units.h"
@@ -19,10 +20,6 @@
 namespace pneumo {
 
 namespace {
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 /// Anterior in world RAS is +y.
 const Vec3 kAnterior(0.0, 1.0, 0.0);
 }  // namespace
