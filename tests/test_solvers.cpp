@@ -554,11 +554,11 @@ TEST(SolverNewmark, TightTolerancesDoNotReportFalseDivergence) {
   // sixth of the damped system's true limit) on the clamped slab under 10 mmHg, asked for a tight equilibrium
   // (residual 1e-6, speed 1e-8 m/s), against the explicit solver, which reaches it: Newmark must converge
   // too, never throw "the time step is too large".
-  // Fails today: the inner loop's stopping test is relative to max|a|, which falls towards zero as the run
-  // reaches equilibrium (and at every zero crossing of the slowest mode); once max|a| is ~1e-9 of the load's
-  // acceleration, rounding in F (~1e-15 of it) is a relative change of ~1e-6 and the loop can never meet its
-  // tolerance: solve_newmark.cpp throws DivergedError at step ≈ 1700 (residual 6.6e-9) with advice to shrink
-  // a time step that is well inside the stable range.
+  // The trap this guards: a stopping test relative to max|a| alone, which falls towards zero near equilibrium
+  // (and at every zero crossing of the slowest mode); at ~1e-9 of the load's acceleration, rounding in F is a
+  // relative change of ~1e-6 and the loop could never meet its tolerance, so the run threw DivergedError
+  // (step ≈ 1700, residual 6.6e-9) blaming a time step well inside the stable range. solve_newmark.cpp now
+  // floors the reference by the load's acceleration.
   const OneThread one_thread;
   const Mesh m = clamped_slab();
   const std::vector<int> dofs = free_dofs(m);

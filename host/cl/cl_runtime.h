@@ -4,6 +4,7 @@
 // Nothing here branches on the device type: the same code runs on PoCL and on a GPU.
 #include <CL/opencl.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -88,6 +89,20 @@ template <class... A>
 void set_args(cl::Kernel& k, const A&... a) {
   cl_uint i = 0;
   (k.setArg(i++, a), ...);
+}
+
+/// A buffer holding `count` elements from `data`, with room for one at least (OpenCL refuses empty buffers).
+/// `blocking` false returns before the copy ends: `data` must then live until the queue's next finish().
+template <class T>
+cl::Buffer upload(Context& ctx, const T* data, std::size_t count, cl_mem_flags flags = CL_MEM_READ_ONLY,
+                  bool blocking = true) {
+  cl::Buffer b(ctx.context(), flags, std::max<std::size_t>(count, 1) * sizeof(T));
+  if (count) ctx.queue().enqueueWriteBuffer(b, blocking ? CL_TRUE : CL_FALSE, 0, count * sizeof(T), data);
+  return b;
+}
+template <class T>
+cl::Buffer upload(Context& ctx, const std::vector<T>& data, cl_mem_flags flags = CL_MEM_READ_ONLY) {
+  return upload(ctx, data.data(), data.size(), flags);
 }
 
 /// Expands `#include "x.cl"` lines from the embedded kernels (each file once).

@@ -78,14 +78,6 @@ void fill_block_table(const Csr& c, const std::vector<int>& blocks, const std::v
       }
 }
 
-template <class T>
-cl::Buffer upload(ocl::Context& ctx, const std::vector<T>& data, cl_mem_flags flags = CL_MEM_READ_ONLY) {
-  const std::size_t bytes = std::max<std::size_t>(data.size() * sizeof(T), sizeof(T));
-  cl::Buffer b(ctx.context(), flags, bytes);
-  if (!data.empty()) ctx.queue().enqueueWriteBuffer(b, CL_TRUE, 0, data.size() * sizeof(T), data.data());
-  return b;
-}
-
 }  // namespace
 
 std::vector<cl_float4> to_float4(const std::vector<Vec3>& v) {

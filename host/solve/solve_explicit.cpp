@@ -1,7 +1,6 @@
 // Explicit integration, symplectic Euler (method.md §6): v ← v + Δt a; x ← x + Δt v.
 #include <cmath>
 
-#include "core/units.h"
 #include "solve/solver_common.h"
 
 namespace pneumo {

@@ -5,9 +5,7 @@
 // (kitasaka_jacobi: all at once, as the device does, for comparing the two step by step);
 // stop when Σ_i |ΔR_i| < β.
 #include <cmath>
-#include <sstream>
 
-#include "core/units.h"
 #include "solve/solver_common.h"
 
 namespace pneumo {

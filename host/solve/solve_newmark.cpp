@@ -3,9 +3,7 @@
 // until the change is below the tolerance, then commit. The loop is a fixed-point iteration: it
 // converges only when ωΔt < 2(√(1+ξ²) − ξ) for every mode, no more stable than explicit.
 #include <cmath>
-#include <sstream>
 
-#include "core/units.h"
 #include "solve/solver_common.h"
 
 namespace pneumo {

@@ -10,7 +10,6 @@
 // tetrahedra on the way.
 #include <cmath>
 
-#include "core/units.h"
 #include "solve/solver_common.h"
 
 namespace pneumo {
@@ -33,7 +32,7 @@ SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vecto
   double residual = INFINITY;
   bool converged = false;
   std::string reason = "step limit";
-  const std::string advice = detail::kStaticAdvice;
+  const std::string advice = detail::kLoadAdvice;
   for (int inc = 1; inc <= increments && step < opt.max_steps; ++inc) {
     model.pressure_pa = detail::increment_pressure(opt, inc, increments);
     const bool last = inc == increments;

@@ -283,7 +283,7 @@ SolveResult static_fire_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions&
       ++step;
       if (step % opt.monitor_every != 0 && step != opt.max_steps) continue;
       const auto o = d.observe(x, v);
-      mon.check_diverged(o.max_displacement, step, detail::kStaticAdvice);
+      mon.check_diverged(o.max_displacement, step, detail::kLoadAdvice);
       residual = o.max_free_force / mon.reference_load();
       if (mon.record(step, 0.0, model.pressure_pa, residual, o.max_displacement, 0.0, lazy_positions(d, x, cache))) {
         reason = "inverted tetrahedra";

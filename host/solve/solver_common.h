@@ -111,7 +111,6 @@ inline const char* kLoadAdvice =
     "no equilibrium within the model's size: the pressure is too high for the material (lower "
     "load.pressure_mmhg or raise material.young_kpa), or tetrahedra turned inside out (solver.on_inverted = "
     "\"stop\" stops at the first)";
-inline const char* kStaticAdvice = kLoadAdvice;
 
 /// Zeroes the held world axes of each node (fixed nodes, symmetry planes).
 void apply_holds(const Mesh& m, std::vector<Vec3>& vec);

@@ -66,11 +66,10 @@ DeviceTets prepare_tets(const WarpMesh& m, const WarpBox& box) {
   return d;
 }
 
+// Uploads return before their copies end (the sources outlive the warp's finish()).
 template <class T>
-cl::Buffer upload(ocl::Context& ctx, const T* data, std::size_t count) {
-  cl::Buffer b(ctx.context(), CL_MEM_READ_ONLY, std::max<std::size_t>(count, 1) * sizeof(T));
-  if (count) ctx.queue().enqueueWriteBuffer(b, CL_FALSE, 0, count * sizeof(T), data);
-  return b;
+cl::Buffer upload_async(ocl::Context& ctx, const T* data, std::size_t count) {
+  return ocl::upload(ctx, data, count, CL_MEM_READ_ONLY, false);
 }
 
 }  // namespace
@@ -95,19 +94,19 @@ WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource
   out.device = ctx.info().spec() + " " + ctx.info().name;
   const DeviceTets dt = prepare_tets(mesh, box);
   timer.lap("prepare");
-  cl::Buffer tet = upload(ctx, dt.rec.data(), dt.rec.size());
-  cl::Buffer bbox = upload(ctx, dt.bbox.data(), dt.bbox.size());
-  cl::Buffer ct = upload(ctx, src.ct_hu, std::size_t(n_src));
+  cl::Buffer tet = upload_async(ctx, dt.rec.data(), dt.rec.size());
+  cl::Buffer bbox = upload_async(ctx, dt.bbox.data(), dt.bbox.size());
+  cl::Buffer ct = upload_async(ctx, src.ct_hu, std::size_t(n_src));
   static_assert(sizeof(Role) == 1, "roles upload as uchar");
-  cl::Buffer roles = upload(ctx, reinterpret_cast<const uint8_t*>(src.roles), std::size_t(n_src));
-  cl::Buffer labels = upload(ctx, src.labels, has_labels ? std::size_t(n_src) : 0);
-  cl::Buffer cubes = upload(ctx, mesh.cube_meshed.data(), mesh.cube_meshed.size());
+  cl::Buffer roles = upload_async(ctx, reinterpret_cast<const uint8_t*>(src.roles), std::size_t(n_src));
+  cl::Buffer labels = upload_async(ctx, src.labels, has_labels ? std::size_t(n_src) : 0);
+  cl::Buffer cubes = upload_async(ctx, mesh.cube_meshed.data(), mesh.cube_meshed.size());
   // The cube of every working-grid index, axis after axis (every index lies in the lattice: it has
   // ceil(dims / L) cubes per axis).
   std::vector<cl_int> cube_of_host;
   for (int a = 0; a < 3; ++a)
     for (int64_t i = 0; i < mesh.grid.dims[a]; ++i) cube_of_host.push_back(cl_int(i / mesh.cube_voxels));
-  cl::Buffer cube_of = upload(ctx, cube_of_host.data(), cube_of_host.size());
+  cl::Buffer cube_of = upload_async(ctx, cube_of_host.data(), cube_of_host.size());
   cl::Buffer owner(ctx.context(), CL_MEM_READ_WRITE, std::size_t(n_out) * sizeof(cl_int));
   ctx.queue().enqueueFillBuffer(owner, cl_int(INT_MAX), 0, std::size_t(n_out) * sizeof(cl_int));
   cl::Buffer out_ct(ctx.context(), CL_MEM_WRITE_ONLY, std::size_t(n_out) * sizeof(float));
