@@ -71,13 +71,19 @@ TEST(BenchSmoke, QuickRunWritesEverySectionWithFiniteNumbers) {
   }
   EXPECT_TRUE(c["render"].contains("cpu_reference"));
 
-  // Speed against accuracy: every solver ran, errors against the reference are there, a front exists.
+  // Speed against accuracy: every solver ran without diverging and reached an error figure against the reference,
+  // or met the harness's wall-clock cap (5 s per run with --quick: a sanitizer build runs 3-10x slower, and a test
+  // must not fail on time); the fastest, the static solver, always gets a figure; a front exists.
   const json& sa = doc["speed_accuracy"];
-  std::set<std::string> solvers;   // those with at least one run that reached an error figure
+  std::set<std::string> solvers;   // those with at least one run that reached an error figure or the time cap
   int on_front = 0;
+  bool has_static_figure = false;
   for (const json& run : sa["runs"]) {
+    EXPECT_TRUE(run["error"].is_null()) << run.dump();
+    if (run["timed_out"].get<bool>()) solvers.insert(run["solver"].get<std::string>());
     if (run["rms_error_mm"].is_number()) {
       solvers.insert(run["solver"].get<std::string>());
+      if (run["solver"] == "static") has_static_figure = true;
       EXPECT_GE(run["rms_error_mm"].get<double>(), 0);
       EXPECT_TRUE(run["warp_mad_hu"].is_number());
       EXPECT_GT(run["skin"]["compared_points"].get<int>(), 0);
@@ -86,6 +92,7 @@ TEST(BenchSmoke, QuickRunWritesEverySectionWithFiniteNumbers) {
     on_front += run["pareto"].get<bool>();
   }
   EXPECT_EQ(solvers, (std::set<std::string>{"static", "explicit", "newmark", "kitasaka2004"}));
+  EXPECT_TRUE(has_static_figure);
   EXPECT_GE(on_front, 1);
   EXPECT_EQ(sa["implied_presets"].size(), 3u);
   EXPECT_EQ(sa["scene_presets"].size(), 3u);

@@ -4,6 +4,9 @@
 // Every case runs on a small synthetic grid (warp_test_support.h) with random HU, on grids with
 // anisotropic spacing and non-identity directions, so index/world slips cannot cancel.
 #include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
 #include <omp.h>
 
 #include <cmath>
@@ -320,4 +323,26 @@ TEST_F(WarpRef, PointMapAgreesWithTheImageWarp) {
   }
   EXPECT_GT(checked, 1000);
   EXPECT_LE(worst, 1e-3);
+}
+
+// A hand-built mesh whose rest-space table stops short of the grid would be read past its end by both warps (they
+// index it without checks, per voxel): check_warp_mesh refuses it at the door, naming the axis; so do broken ids.
+TEST_F(WarpRef, MeshesThatBreakTheIndexingAreRefusedBeforeWarping) {
+  const WarpCase c = make_warp_case(grid_of({24, 24, 16}, {0.75, 0.75, 1.5}, Vec3(-1, -1, 1).asDiagonal()), 4, 11);
+  const WarpMesh good = make_warp_mesh(c.mesh, std::vector<Vec3>(std::size_t(c.mesh.node_count()), Vec3::Zero()));
+  EXPECT_NO_THROW(check_warp_mesh(good));
+
+  WarpMesh short_table = good;
+  short_table.cubes[0] -= 1;
+  short_table.cube_meshed.resize(std::size_t(short_table.cubes[0] * short_table.cubes[1] * short_table.cubes[2]));
+  try {
+    warp_ref(short_table, c.source(), c.whole(), options());
+    ADD_FAILURE() << "a rest-space table one cube short was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("axis 0"), std::string::npos) << e.what();
+  }
+
+  WarpMesh bad_id = good;
+  bad_id.tets[0][2] = int32_t(bad_id.rest_ijk.size());
+  EXPECT_THROW(warp_ref(bad_id, c.source(), c.whole(), options()), std::invalid_argument);
 }

@@ -136,9 +136,11 @@ PeerWarpCase make_peer_warp_case(const Geometry& grid, std::vector<float> ct_hu,
           m.tets.push_back(tet);
         }
   m.tet_part.assign(m.tets.size(), Part::Wall);
+  // The rest-space table covers the grid (ceil(dims / L) cubes: one more than the mesh has where dims − 1 is a
+  // multiple of L, the last voxels lying on its boundary plane); every voxel is inside the script's rest mesh.
   m.cube_voxels = node_step;
-  m.cubes = {cubes[0], cubes[1], cubes[2]};
-  m.cube_meshed.assign(std::size_t(cubes[0] * cubes[1] * cubes[2]), 1);
+  for (int a = 0; a < 3; ++a) m.cubes[a] = (grid.dims[a] + node_step - 1) / node_step;
+  m.cube_meshed.assign(std::size_t(m.cubes[0] * m.cubes[1] * m.cubes[2]), 1);
 
   for (const auto& t : m.tets) {
     const double rest = signed_volume6(m.rest_ijk[t[0]], m.rest_ijk[t[1]], m.rest_ijk[t[2]], m.rest_ijk[t[3]]);

@@ -76,6 +76,7 @@ cl::Buffer upload_async(ocl::Context& ctx, const T* data, std::size_t count) {
 
 WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,
                        const WarpOptions& opt) {
+  check_warp_mesh(mesh);
   const int64_t T = mesh.tet_count();
   const int64_t n_src = mesh.grid.voxel_count(), n_out = box.voxel_count();
   // The kernel indexes 8 values per tetrahedron in int.

@@ -39,6 +39,22 @@ WarpMesh make_warp_mesh(const Mesh& mesh, const std::vector<Vec3>& displacement_
   return w;
 }
 
+void check_warp_mesh(const WarpMesh& m) {
+  auto fail = [](const std::string& what) { throw std::invalid_argument("warp mesh: " + what); };
+  const int64_t nodes = int64_t(m.rest_ijk.size());
+  if (int64_t(m.disp_ijk.size()) != nodes) fail("a displacement per node needed");
+  if (m.tet_part.size() != m.tets.size()) fail("a part per tetrahedron needed");
+  for (const auto& t : m.tets)
+    for (int32_t n : t)
+      if (n < 0 || n >= nodes) fail("node id " + std::to_string(n) + " out of range (" + std::to_string(nodes) + " nodes)");
+  if (m.cube_voxels < 1) fail("cube_voxels must be at least 1");
+  for (int a = 0; a < 3; ++a)
+    if (m.cubes[a] < (m.grid.dims[a] + m.cube_voxels - 1) / m.cube_voxels)
+      fail("the rest-space table has " + std::to_string(m.cubes[a]) + " cubes on axis " + std::to_string(a) +
+           ", fewer than the grid's " + std::to_string(m.grid.dims[a]) + " voxels need");
+  if (int64_t(m.cube_meshed.size()) != m.cubes[0] * m.cubes[1] * m.cubes[2]) fail("cube_meshed size");
+}
+
 bool warp_tet_degenerate(const WarpMesh& m, int64_t tet) {
   const auto& t = m.tets[std::size_t(tet)];
   const Vec3 x0 = m.deformed_ijk(t[0]);

@@ -38,6 +38,12 @@ struct WarpMesh {
   bool in_rest_space(int64_t i, int64_t j, int64_t k) const;
 };
 
+/// Throws std::invalid_argument naming the first thing `m` gets wrong of what both warps index by without checks:
+/// sizes (a part per tetrahedron, a displacement per node), node ids in range, and a rest-space table covering the
+/// grid (ceil(dims / cube_voxels) cubes per axis at least). make_warp_mesh's meshes always pass; hand-built ones
+/// (the peers' case in bench/) are checked at the warp's door.
+void check_warp_mesh(const WarpMesh& m);
+
 /// The warp mesh of `mesh` displaced by `displacement_m` (metres, one per node, world RAS+).
 /// std::invalid_argument when the sizes differ.
 WarpMesh make_warp_mesh(const Mesh& mesh, const std::vector<Vec3>& displacement_m);

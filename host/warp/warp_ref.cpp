@@ -94,6 +94,7 @@ const uint8_t* rest_row(const WarpMesh& m, int64_t j, int64_t k) {
 }  // namespace
 
 WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt) {
+  check_warp_mesh(mesh);
   PhaseTimer timer("warp on cpu");
   const int64_t T = mesh.tet_count();
   std::vector<RefTet> tets(static_cast<std::size_t>(T));
