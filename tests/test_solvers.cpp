@@ -481,6 +481,28 @@ TEST(SolverSnapshots, ShownEveryNStepsWithTheCurrentPositions) {
   }
 }
 
+// The 2004 scheme's force-evaluation count, which the bench's cost figures divide by: a Gauss-Seidel sweep is one
+// evaluation (forces node by node, outside the evaluator) plus one per monitoring step (the residual); a Jacobi sweep
+// evaluates through the evaluator, and the monitor's evaluation at the new positions serves the next sweep, so a
+// run that ends on a monitored step costs exactly steps + 1. Both orders stop at the same step limit here.
+TEST(SolverKitasaka, ForceEvaluationsCountEachEvaluationOnce) {
+  const OneThread one_thread;
+  const Mesh m = clamped_slab();
+  for (bool jacobi : {false, true}) {
+    SCOPED_TRACE(jacobi ? "jacobi" : "gauss-seidel");
+    SolveOptions o = quiet(SolverMethod::Kitasaka2004);
+    o.forces.pressure_pa = units::mmhg_to_pa(10.0);
+    o.kitasaka_tolerance_m = 1e-30;   // never met: the run stops at the step limit, a monitored step
+    o.max_steps = 95;
+    o.monitor_every = 10;
+    o.kitasaka_jacobi = jacobi;
+    const SolveResult r = solve(m, o);
+    ASSERT_EQ(r.steps, 95);
+    const int64_t monitors = 10;   // steps 10, 20, ..., 90 and the last, 95
+    EXPECT_EQ(r.force_evaluations, jacobi ? r.steps + 1 : r.steps + monitors);
+  }
+}
+
 // ---- divergence -------------------------------------------------------------------------------------------------
 
 TEST(SolverDivergence, NewmarkBeyondItsStableStepThrows) {

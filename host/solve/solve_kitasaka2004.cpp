@@ -56,9 +56,12 @@ SolveResult solve_kitasaka2004(const Mesh& m, const SolveOptions& opt, std::vect
   bool converged = false;
   std::string reason = "step limit";
   const std::string advice = detail::kKitasakaAdvice;
+  bool f_is_current = false;   // f holds the forces at x (the monitor just evaluated them)
   while (step < opt.max_steps) {
     moved = 0.0;
-    if (opt.kitasaka_jacobi) eval.evaluate(model, x, {}, f);   // every node from the same positions
+    // Jacobi: every node from the same positions' forces.
+    if (opt.kitasaka_jacobi && !f_is_current) eval.evaluate(model, x, {}, f);
+    f_is_current = false;
     for (int64_t n = 0; n < N; ++n) {
       if (m.hold[n] == kHoldAll || !(stiffness[n] > 0.0)) continue;
       Vec3 d = opt.kitasaka_step / stiffness[n] * (opt.kitasaka_jacobi ? f[n] : node_force(m, adj, model, x, n));
@@ -72,14 +75,17 @@ SolveResult solve_kitasaka2004(const Mesh& m, const SolveOptions& opt, std::vect
     if (done || step % opt.monitor_every == 0 || step == opt.max_steps) {
       mon.check_diverged(x, step, advice);
       eval.evaluate(model, x, {}, f);
+      f_is_current = true;
       residual = mon.residual(f);
       if (mon.record(step, 0.0, model.pressure_pa, residual, x, {})) { reason = "inverted tetrahedra"; break; }
       if (done) { converged = true; reason = "converged"; break; }
     }
   }
   r.final_pressure_pa = model.pressure_pa;
-  // One sweep evaluates every node's force once: count it as one force evaluation.
-  mon.finish(x, {}, step, step + eval.evaluations(), converged, reason, residual);
+  // A Gauss-Seidel sweep evaluates every node's force once, outside `eval`: count it as one force evaluation.
+  // Jacobi sweeps evaluate through `eval`, which counts them already.
+  const int64_t sweeps_outside_eval = opt.kitasaka_jacobi ? 0 : step;
+  mon.finish(x, {}, step, sweeps_outside_eval + eval.evaluations(), converged, reason, residual);
   return r;
 }
 

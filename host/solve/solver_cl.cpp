@@ -207,15 +207,20 @@ SolveResult kitasaka_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& op
   int64_t step = 0, evaluations = 0;
   double residual = INFINITY;
   std::string reason;
+  bool forces_are_current = false;   // the monitor just evaluated them at these positions
   while (step < opt.max_steps) {
-    d.eval.evaluate(model, ClForceEvaluator::Nodes::Free);
-    ++evaluations;
+    if (!forces_are_current) {
+      d.eval.evaluate(model, ClForceEvaluator::Nodes::Free);
+      ++evaluations;
+    }
+    forces_are_current = false;
     const double moved = d.reduce(step_k, true)[0];
     ++step;
     const bool done = moved < opt.kitasaka_tolerance_m;
     if (!done && step % opt.monitor_every != 0 && step != opt.max_steps) continue;
     d.eval.evaluate(model, ClForceEvaluator::Nodes::Free);   // forces at the new positions, for the residual
     ++evaluations;
+    forces_are_current = true;
     const auto o = d.observe(d.eval.positions(), d.eval.velocities());
     mon.check_diverged(o.max_displacement, step, detail::kKitasakaAdvice);
     residual = o.max_free_force / mon.reference_load();
