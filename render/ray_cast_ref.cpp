@@ -16,8 +16,10 @@ struct Sampler {
 
   float at(int64_t i, int64_t j, int64_t k) const { return v.hu[i + nx * (j + ny * k)]; }
 
-  // Trilinear HU at a continuous index; positions beyond the voxel centres clamp to the edge.
-  double hu(const Vec3& p) const {
+  // Trilinear blend of per-voxel values `at(i, j, k)` at a continuous index; positions beyond the voxel centres
+  // clamp to the edge.
+  template <class T, class At>
+  T trilinear(const Vec3& p, const At& at) const {
     const double x = std::clamp(p.x(), 0.0, double(nx - 1));
     const double y = std::clamp(p.y(), 0.0, double(ny - 1));
     const double z = std::clamp(p.z(), 0.0, double(nz - 1));
@@ -25,32 +27,24 @@ struct Sampler {
                   k = std::min<int64_t>(int64_t(z), nz - 1);
     const int64_t i1 = std::min(i + 1, nx - 1), j1 = std::min(j + 1, ny - 1), k1 = std::min(k + 1, nz - 1);
     const double fx = x - i, fy = y - j, fz = z - k;
-    const double c00 = at(i, j, k) * (1 - fx) + at(i1, j, k) * fx;
-    const double c10 = at(i, j1, k) * (1 - fx) + at(i1, j1, k) * fx;
-    const double c01 = at(i, j, k1) * (1 - fx) + at(i1, j, k1) * fx;
-    const double c11 = at(i, j1, k1) * (1 - fx) + at(i1, j1, k1) * fx;
+    const T c00 = at(i, j, k) * (1 - fx) + at(i1, j, k) * fx;
+    const T c10 = at(i, j1, k) * (1 - fx) + at(i1, j1, k) * fx;
+    const T c01 = at(i, j, k1) * (1 - fx) + at(i1, j, k1) * fx;
+    const T c11 = at(i, j1, k1) * (1 - fx) + at(i1, j1, k1) * fx;
     return (c00 * (1 - fy) + c10 * fy) * (1 - fz) + (c01 * (1 - fy) + c11 * fy) * fz;
   }
 
-  // Trilinear interpolation of the per-voxel gradients (voxel_gradient(), HU per voxel index) at a
-  // continuous index, clamped like hu().
+  // Trilinear HU.
+  double hu(const Vec3& p) const {
+    return trilinear<double>(p, [&](int64_t i, int64_t j, int64_t k) { return double(at(i, j, k)); });
+  }
+
+  // Trilinear interpolation of the per-voxel gradients (voxel_gradient(), HU per voxel index).
   Vec3 gradient(const Vec3& p) const {
-    const double x = std::clamp(p.x(), 0.0, double(nx - 1));
-    const double y = std::clamp(p.y(), 0.0, double(ny - 1));
-    const double z = std::clamp(p.z(), 0.0, double(nz - 1));
-    const int64_t i = std::min<int64_t>(int64_t(x), nx - 1), j = std::min<int64_t>(int64_t(y), ny - 1),
-                  k = std::min<int64_t>(int64_t(z), nz - 1);
-    const int64_t i1 = std::min(i + 1, nx - 1), j1 = std::min(j + 1, ny - 1), k1 = std::min(k + 1, nz - 1);
-    const double fx = x - i, fy = y - j, fz = z - k;
-    auto g = [&](int64_t a, int64_t b, int64_t c) {
-      const auto q = voxel_gradient(v, a, b, c);
-      return Vec3(q[0], q[1], q[2]);
-    };
-    const Vec3 c00 = g(i, j, k) * (1 - fx) + g(i1, j, k) * fx;
-    const Vec3 c10 = g(i, j1, k) * (1 - fx) + g(i1, j1, k) * fx;
-    const Vec3 c01 = g(i, j, k1) * (1 - fx) + g(i1, j, k1) * fx;
-    const Vec3 c11 = g(i, j1, k1) * (1 - fx) + g(i1, j1, k1) * fx;
-    return kGradientHalf * ((c00 * (1 - fy) + c10 * fy) * (1 - fz) + (c01 * (1 - fy) + c11 * fy) * fz);
+    return kGradientHalf * trilinear<Vec3>(p, [&](int64_t i, int64_t j, int64_t k) {
+             const auto q = voxel_gradient(v, i, j, k);
+             return Vec3(q[0], q[1], q[2]);
+           });
   }
 
   uint16_t label(const Vec3& p) const {

@@ -17,6 +17,16 @@ std::string with_defines(const std::string& src, const std::vector<std::string>&
   return src.substr(0, eol + 1) + extra + src.substr(eol + 1);
 }
 
+/// The info log of a shader or program, through its getters (glGetShaderiv/InfoLog or glGetProgramiv/InfoLog).
+template <class GetIv, class GetLog>
+std::string info_log(GLuint object, GetIv get_iv, GetLog get_log) {
+  GLint len = 0;
+  get_iv(object, GL_INFO_LOG_LENGTH, &len);
+  std::string log(std::max(len, 1), '\0');
+  get_log(object, len, nullptr, log.data());
+  return log;
+}
+
 GLuint compile(GLenum type, const std::string& path, const std::vector<std::string>& defines) {
   const Api& g = api();
   const std::string src = with_defines(shader_source(path), defines);
@@ -27,10 +37,7 @@ GLuint compile(GLenum type, const std::string& path, const std::vector<std::stri
   GLint ok = 0;
   g.GetShaderiv(s, GL_COMPILE_STATUS, &ok);
   if (!ok) {
-    GLint len = 0;
-    g.GetShaderiv(s, GL_INFO_LOG_LENGTH, &len);
-    std::string log(std::max(len, 1), '\0');
-    g.GetShaderInfoLog(s, len, nullptr, log.data());
+    const std::string log = info_log(s, g.GetShaderiv, g.GetShaderInfoLog);
     g.DeleteShader(s);
     throw std::runtime_error("shader " + path + " does not compile: " + log);
   }
@@ -59,10 +66,7 @@ ShaderProgram::ShaderProgram(const std::string& vertex_path, const std::string& 
   GLint ok = 0;
   g.GetProgramiv(program_, GL_LINK_STATUS, &ok);
   if (!ok) {
-    GLint len = 0;
-    g.GetProgramiv(program_, GL_INFO_LOG_LENGTH, &len);
-    std::string log(std::max(len, 1), '\0');
-    g.GetProgramInfoLog(program_, len, nullptr, log.data());
+    const std::string log = info_log(program_, g.GetProgramiv, g.GetProgramInfoLog);
     g.DeleteProgram(program_);
     throw std::runtime_error("shaders " + vertex_path + " + " + fragment_path + " do not link: " + log);
   }
