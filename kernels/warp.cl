@@ -8,7 +8,7 @@
 //    source point and checks the role there; it records the lowest accepting tetrahedron's index
 //    per voxel with atomic_min (T, one past the last index, marks "inside a deformed tetrahedron
 //    but accepted by none"; INT_MAX "inside none"). The lowest index wins whatever the schedule.
-//  warp_sample (one work-item per 32 voxels of a row) recomputes the winner's weights and source point
+//  warp_sample (one work-item per few voxels of a row) recomputes the winner's weights and source point
 //    (the same arithmetic, so the same bits) and samples: CT trilinear, label nearest; or gas; or
 //    the voxel's own value.
 //
@@ -122,24 +122,24 @@ float ct_trilinear(__global const float* restrict ct, const int4 d, const float3
   return c0 * (1.0f - f.z) + c1 * f.z;
 }
 
-#define ROW_CHUNK 32
-
-// One work-item per ROW_CHUNK consecutive output voxels of a row (one per voxel would make millions
-// of tiny work-groups, whose launch costs more than their work on a CPU device). Global size: the
-// row count × ceil(box_dims.x / ROW_CHUNK), rounded up to the local size.
+// One work-item per `row_chunk` consecutive output voxels of a row. A CPU device wants long chunks
+// (one work-item per voxel makes millions of tiny work-groups, whose launch costs more than their
+// work); a GPU wants 1, so that neighbouring work-items read and write neighbouring voxels and its
+// memory accesses coalesce. Global size: the row count × ceil(box_dims.x / row_chunk), rounded up
+// to the local size.
 __kernel void warp_sample(__global const float4* restrict tet, __global const int* restrict owner, const int n_tets,
                           __global const float* restrict ct, __global const ushort* restrict labels,
                           const int has_labels, const int4 src_dims, const int4 box_lo, const int4 box_dims,
                           __global const uchar* restrict cube_meshed, const int4 cubes,
                           __global const int* restrict cube_of, const float gas_hu, const ushort cavity_label,
-                          __global float* restrict out_ct, __global ushort* restrict out_labels,
+                          const int row_chunk, __global float* restrict out_ct, __global ushort* restrict out_labels,
                           __global uchar* restrict out_outcome) {
   const long gid = get_global_id(0);
-  const int chunks = (box_dims.x + ROW_CHUNK - 1) / ROW_CHUNK;
+  const int chunks = (box_dims.x + row_chunk - 1) / row_chunk;
   const long row = gid / chunks;
   if (row >= (long)box_dims.y * (long)box_dims.z) return;
   const int y = (int)(row % box_dims.y), z = (int)(row / box_dims.y);
-  const int x_begin = (int)(gid % chunks) * ROW_CHUNK, x_end = min(box_dims.x, x_begin + ROW_CHUNK);
+  const int x_begin = (int)(gid % chunks) * row_chunk, x_end = min(box_dims.x, x_begin + row_chunk);
   const int j = y + box_lo.y, k = z + box_lo.z;
   // cube_of: the lattice cube of each index, axis after axis (a table: no divisions per voxel).
   const long cube_row = (long)cubes.x * ((long)cube_of[src_dims.x + j] + (long)cubes.y * (long)cube_of[src_dims.x + src_dims.y + k]);

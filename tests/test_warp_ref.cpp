@@ -23,36 +23,6 @@ using namespace pneumo::testing_support;
 
 namespace {
 
-Geometry grid_of(Index3 dims, Vec3 spacing, Mat3 direction, Vec3 origin = Vec3(-31.0, 12.5, 140.0)) {
-  Geometry g;
-  g.dims = dims;
-  g.spacing_mm = spacing;
-  g.direction = direction;
-  g.origin_mm = origin;
-  return g;
-}
-
-Mat3 rotation(double deg, Vec3 axis) { return Eigen::AngleAxisd(deg * M_PI / 180.0, axis.normalized()).toRotationMatrix(); }
-
-/// The test's own trilinear interpolation (8 weighted corners), independent of warp_sampling.h.
-double trilinear(const WarpCase& c, const Vec3& p) {
-  const Index3& d = c.grid.dims;
-  double sum = 0.0;
-  const Eigen::Vector3d fl(std::floor(p[0]), std::floor(p[1]), std::floor(p[2]));
-  for (int corner = 0; corner < 8; ++corner) {
-    double w = 1.0;
-    int64_t q[3];
-    for (int a = 0; a < 3; ++a) {
-      const int bit = (corner >> a) & 1;
-      const double f = p[a] - fl[a];
-      w *= bit ? f : 1.0 - f;
-      q[a] = std::clamp<int64_t>(int64_t(fl[a]) + bit, 0, d[a] - 1);
-    }
-    sum += w * c.ct[std::size_t(c.grid.linear_index(q[0], q[1], q[2]))];
-  }
-  return sum;
-}
-
 WarpOptions options() {
   WarpOptions o;
   o.cavity_label = 250;
@@ -127,49 +97,15 @@ TEST_F(WarpRef, WholeVoxelTranslationShiftsExactly) {
 // and rounds once to float (ulp 1.2e-4 at 1500 HU). No cracks: every voxel whose source lies in
 // the meshed space (0.01 voxel clear of its boundary) must be carried, none may be gas.
 TEST_F(WarpRef, AffineMatchesAnalyticResamplingWithNoCracks) {
-  const WarpCase c =
-      make_warp_case(grid_of({32, 28, 24}, {0.7, 0.9, 1.3}, rotation(20, Vec3(1, 2, 3))), 4, 13);
-  const Vec3 centre(16, 14, 12);
-  const Mat3 M = rotation(3, Vec3(0.3, -1, 0.5)) * Vec3(1.04, 0.97, 1.02).asDiagonal();
-  const Vec3 b = centre - M * centre + Vec3(1.3, -0.7, 0.4);
-  const WarpMesh m = make_warp_mesh(c.mesh, displacement_of(c, [&](const Vec3& x) { return Vec3(M * x + b); }));
-  const WarpResult r = warp_ref(m, c.source(), c.whole(), options());
-  const auto parts = cube_parts(c.mesh);
-  const Mat3 M_inv = M.inverse();
-  int64_t checked = 0, cracks = 0, label_ties = 0;
-  double worst = 0.0;
-  for (int64_t k = 0; k < 24; ++k)
-    for (int64_t j = 0; j < 28; ++j)
-      for (int64_t i = 0; i < 32; ++i) {
-        const Vec3 s = M_inv * (Vec3(double(i), double(j), double(k)) - b);
-        bool clear = true;
-        for (int corner = 0; corner < 8 && clear; ++corner) {
-          const Vec3 e(corner & 1 ? 0.01 : -0.01, corner & 2 ? 0.01 : -0.01, corner & 4 ? 0.01 : -0.01);
-          clear = parts_at(c.mesh, parts, s + e) != 0;
-        }
-        if (!clear) continue;
-        const int64_t n = c.grid.linear_index(i, j, k);
-        ++checked;
-        if (r.outcome[n] != WarpOutcome::Carried) {
-          ++cracks;
-          continue;
-        }
-        worst = std::max(worst, std::abs(double(r.ct_hu[n]) - trilinear(c, s)));
-        bool tie = false;
-        for (int a = 0; a < 3; ++a) tie |= std::abs(s[a] - std::floor(s[a]) - 0.5) < 1e-6;
-        if (tie) {
-          ++label_ties;
-          continue;
-        }
-        const int64_t v = c.grid.linear_index(int64_t(std::floor(s[0] + 0.5)), int64_t(std::floor(s[1] + 0.5)),
-                                              int64_t(std::floor(s[2] + 0.5)));
-        EXPECT_EQ(r.labels[n], c.labels[v]) << "voxel " << i << "," << j << "," << k;
-      }
-  EXPECT_GT(checked, 3000);
-  EXPECT_EQ(cracks, 0) << "voxels inside the deformed mesh left uncovered";
-  EXPECT_LE(worst, 1e-3) << "HU off analytic affine resampling";
-  std::printf("affine: %lld voxels checked, max |Δ| %.2e HU, %lld nearest-label ties skipped\n", (long long)checked,
-              worst, (long long)label_ties);
+  const AffineCase a = affine_case();
+  const WarpResult r = warp_ref(a.mesh, a.c.source(), a.c.whole(), options());
+  const AffineCheck check = check_affine(a, r, 1e-6);
+  EXPECT_GT(check.checked, 3000);
+  EXPECT_EQ(check.cracks, 0) << "voxels inside the deformed mesh left uncovered";
+  EXPECT_LE(check.worst_hu, 1e-3) << "HU off analytic affine resampling";
+  EXPECT_EQ(check.label_mismatches, 0) << "labels off the nearest source voxel";
+  std::printf("affine: %lld voxels checked, max |Δ| %.2e HU, %lld nearest-label ties skipped\n",
+              (long long)check.checked, check.worst_hu, (long long)check.label_ties);
 }
 
 // Role acceptance and the gas rule (§7): the wall rises 3 voxels, the viscera sink 1. In the doubled

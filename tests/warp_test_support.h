@@ -5,6 +5,8 @@
 // interpolation: neighbouring voxels differ by up to 2500 HU), and its mesh.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -104,6 +106,123 @@ inline uint8_t parts_at(const Mesh& m, const std::vector<uint8_t>& parts, const 
     q[a] = int64_t(f);
   }
   return parts[std::size_t(q[0] + m.cubes[0] * (q[1] + m.cubes[1] * q[2]))];
+}
+
+inline Geometry grid_of(Index3 dims, Vec3 spacing, Mat3 direction, Vec3 origin = Vec3(-31.0, 12.5, 140.0)) {
+  Geometry g;
+  g.dims = dims;
+  g.spacing_mm = spacing;
+  g.direction = direction;
+  g.origin_mm = origin;
+  return g;
+}
+
+inline Mat3 rotation(double deg, Vec3 axis) {
+  return Eigen::AngleAxisd(deg * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+}
+
+/// The test's own trilinear interpolation (8 weighted corners), independent of warp_sampling.h.
+inline double trilinear(const WarpCase& c, const Vec3& p) {
+  const Index3& d = c.grid.dims;
+  double sum = 0.0;
+  const Eigen::Vector3d fl(std::floor(p[0]), std::floor(p[1]), std::floor(p[2]));
+  for (int corner = 0; corner < 8; ++corner) {
+    double w = 1.0;
+    int64_t q[3];
+    for (int a = 0; a < 3; ++a) {
+      const int bit = (corner >> a) & 1;
+      const double f = p[a] - fl[a];
+      w *= bit ? f : 1.0 - f;
+      q[a] = std::clamp<int64_t>(int64_t(fl[a]) + bit, 0, d[a] - 1);
+    }
+    sum += w * c.ct[std::size_t(c.grid.linear_index(q[0], q[1], q[2]))];
+  }
+  return sum;
+}
+
+/// An affine deformation x ↦ M x + b (index coordinates) of a case on an oblique, anisotropic grid.
+struct AffineCase {
+  WarpCase c;
+  Mat3 M;
+  Vec3 b;
+  WarpMesh mesh;
+};
+inline AffineCase affine_case() {
+  AffineCase a;
+  a.c = make_warp_case(grid_of({32, 28, 24}, {0.7, 0.9, 1.3}, rotation(20, Vec3(1, 2, 3))), 4, 13);
+  const Vec3 centre(16, 14, 12);
+  a.M = rotation(3, Vec3(0.3, -1, 0.5)) * Vec3(1.04, 0.97, 1.02).asDiagonal();
+  a.b = centre - a.M * centre + Vec3(1.3, -0.7, 0.4);
+  a.mesh = make_warp_mesh(a.c.mesh, displacement_of(a.c, [&](const Vec3& x) { return Vec3(a.M * x + a.b); }));
+  return a;
+}
+
+/// A warp of affine_case() against analytic affine resampling: the value at P′ is the trilinear
+/// interpolation of the input at M⁻¹(P′ − b), the label its nearest voxel's (skipped as a tie where a
+/// source coordinate lies within half_band of a half). Only voxels whose source lies in the meshed
+/// space, 0.01 voxel clear of its boundary, are checked; each must be carried (else a crack).
+struct AffineCheck {
+  int64_t checked = 0, cracks = 0, label_ties = 0, label_mismatches = 0;
+  double worst_hu = 0.0;
+};
+inline AffineCheck check_affine(const AffineCase& a, const WarpResult& r, double half_band) {
+  const WarpCase& c = a.c;
+  const auto parts = cube_parts(c.mesh);
+  const Mat3 M_inv = a.M.inverse();
+  AffineCheck out;
+  for (int64_t k = 0; k < c.grid.dims[2]; ++k)
+    for (int64_t j = 0; j < c.grid.dims[1]; ++j)
+      for (int64_t i = 0; i < c.grid.dims[0]; ++i) {
+        const Vec3 s = M_inv * (Vec3(double(i), double(j), double(k)) - a.b);
+        bool clear = true;
+        for (int corner = 0; corner < 8 && clear; ++corner) {
+          const Vec3 e(corner & 1 ? 0.01 : -0.01, corner & 2 ? 0.01 : -0.01, corner & 4 ? 0.01 : -0.01);
+          clear = parts_at(c.mesh, parts, s + e) != 0;
+        }
+        if (!clear) continue;
+        const int64_t n = c.grid.linear_index(i, j, k);
+        ++out.checked;
+        if (r.outcome[n] != WarpOutcome::Carried) {
+          ++out.cracks;
+          continue;
+        }
+        out.worst_hu = std::max(out.worst_hu, std::abs(double(r.ct_hu[n]) - trilinear(c, s)));
+        bool tie = false;
+        for (int d = 0; d < 3; ++d) tie |= std::abs(s[d] - std::floor(s[d]) - 0.5) < half_band;
+        if (tie) {
+          ++out.label_ties;
+          continue;
+        }
+        const int64_t v = c.grid.linear_index(int64_t(std::floor(s[0] + 0.5)), int64_t(std::floor(s[1] + 0.5)),
+                                              int64_t(std::floor(s[2] + 0.5)));
+        if (r.labels[n] != c.labels[v]) ++out.label_mismatches;
+      }
+  return out;
+}
+
+/// Whether rounding may decide the outcome or nearest voxel at index point p: some deformed
+/// tetrahedron's weight lies within 1e-5 of −kWarpTolerance there (containment decided by
+/// rounding), or a tetrahedron containing p maps it to a source coordinate within 1e-4 of a half
+/// (nearest voxel, so role and label, decided by rounding). float32 puts a source point ~1e-5 voxel
+/// off; both bands leave room. Loops over every tetrahedron: for the few voxels that differ.
+inline bool measured_tie(const WarpMesh& m, const Vec3& p) {
+  constexpr double kWeightBand = 1e-5, kHalfBand = 1e-4;
+  for (int64_t t = 0; t < m.tet_count(); ++t) {
+    if (warp_tet_degenerate(m, t)) continue;
+    const auto& v = m.tets[std::size_t(t)];
+    const Vec3 x0 = m.deformed_ijk(v[0]), d0 = m.disp_ijk[v[0]];
+    Mat3 e, dd;
+    e << m.deformed_ijk(v[1]) - x0, m.deformed_ijk(v[2]) - x0, m.deformed_ijk(v[3]) - x0;
+    dd << m.disp_ijk[v[1]] - d0, m.disp_ijk[v[2]] - d0, m.disp_ijk[v[3]] - d0;
+    const Vec3 w = e.inverse() * (p - x0);
+    const double lowest = std::min(1.0 - w.sum(), w.minCoeff());
+    if (std::abs(lowest + kWarpTolerance) < kWeightBand) return true;
+    if (lowest < -kWarpTolerance - kWeightBand) continue;
+    const Vec3 s = p - (d0 + dd * w);
+    for (int a = 0; a < 3; ++a)
+      if (std::abs(s[a] - std::floor(s[a]) - 0.5) < kHalfBand) return true;
+  }
+  return false;
 }
 
 }  // namespace pneumo::testing_support

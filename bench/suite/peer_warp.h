@@ -44,6 +44,8 @@ struct PeerWarpOptions {
   int node_step = 8;        // vtk_tetwarp.py --node-step
   double amp_mm = 30.0;     // vtk_tetwarp.py --amp
   std::vector<std::string> devices{"cpu", "opencl"};
+  int repeats = 1;          // warps per device: every time is kept, the median reported
+  bool skip_field = false;  // no disp_pneumo.mhd
 };
 
 /// Warps the peers' case on each device and writes into out_dir: warped_<device>.mhd (float32 HU; device "cpu" or

@@ -27,6 +27,13 @@ Run add_bench(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--amp", peer->amp_mm, "--peer-warp: the lift's amplitude, mm (vtk_tetwarp.py --amp)")
       ->capture_default_str();
+  cmd->add_option("--peer-device", peer->devices, "--peer-warp: the devices to warp on (repeat the flag)")
+      ->capture_default_str();
+  cmd->add_option("--repeats", peer->repeats, "--peer-warp: warps per device; the median time is reported")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  cmd->add_flag("--no-field", peer->skip_field,
+                "--peer-warp: skip disp_pneumo.mhd (the dense field through PointMap that compare_warp.sh hands ITK)");
   return [o, peer] {
     if (!peer->data_dir.empty()) {
       const nlohmann::json doc = bench::run_peer_warp(*peer);

@@ -45,6 +45,9 @@ struct WarpBox {
 struct WarpOptions {
   uint16_t cavity_label = 250;
   float gas_hu = -1000.0f;
+  /// OpenCL only: output voxels of a row per work-item of the sample pass; 0 picks by device type
+  /// (32 on a CPU, 1 on a GPU: kernels/warp.cl says why). The result does not depend on it.
+  int row_chunk = 0;
 };
 
 /// What happened at each output voxel.

@@ -125,11 +125,11 @@ WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource
   ctx.queue().finish();
   timer.lap("scatter");
   cl::Kernel sample = ctx.kernel("warp.cl", "warp_sample");
+  const int64_t chunk = opt.row_chunk > 0 ? opt.row_chunk : ctx.info().type == "cpu" ? 32 : 1;
   ocl::set_args(sample, tet, owner, cl_int(T), ct, labels, cl_int(has_labels ? 1 : 0), src_dims, box_lo, box_dims,
                 cubes, int4_of(Index3{mesh.cubes[0], mesh.cubes[1], mesh.cubes[2]}), cube_of,
-                cl_float(opt.gas_hu), cl_ushort(opt.cavity_label), out_ct, out_labels, out_outcome);
-  constexpr int64_t kRowChunk = 32;   // ROW_CHUNK of kernels/warp.cl
-  const int64_t items = (box.dims[0] + kRowChunk - 1) / kRowChunk * box.dims[1] * box.dims[2];
+                cl_float(opt.gas_hu), cl_ushort(opt.cavity_label), cl_int(chunk), out_ct, out_labels, out_outcome);
+  const int64_t items = (box.dims[0] + chunk - 1) / chunk * box.dims[1] * box.dims[2];
   ctx.queue().enqueueNDRangeKernel(sample, cl::NullRange, cl::NDRange((std::size_t(items) + kLocal - 1) / kLocal * kLocal),
                                    cl::NDRange(kLocal));
   ctx.queue().finish();

@@ -1,11 +1,13 @@
 // The CPU reference of the image warp (warp.h states the rules; method.md §7). Double precision,
 // written apart from the kernel (kernels/warp.cl) so the equality test is not blind to shared bugs.
 //
-// Scatter without atomics: the output is cut into slabs of a few k-planes; each tetrahedron is
-// listed, in index order, under every slab its bounding box touches. One thread owns a slab at a
-// time and visits its tetrahedra in ascending order, so "the lowest accepting index wins" is "the
-// first accepting one wins", whatever the thread count. Each slab records, per voxel, the winning
-// tetrahedron and its source point, then samples the CT and labels there.
+// Scatter without atomics: the output is cut into tiles small enough that a tile's output and the
+// source it reads stay in a core's L2 cache (a voxel's trilinear stencil and role lookup are
+// gathers: from L3 or DRAM they, not the arithmetic, set the speed). Each tetrahedron is listed,
+// in index order, under every tile its bounding box touches. One thread owns a tile at a time and
+// visits its tetrahedra in ascending order, so "the lowest accepting index wins" is "the first
+// accepting one wins", whatever the thread count: the first one samples the CT and labels at its
+// source point there and then, and later ones leave the voxel alone.
 #include <omp.h>
 
 #include <algorithm>
@@ -21,7 +23,10 @@ namespace pneumo {
 
 namespace {
 
-constexpr int64_t kSlabPlanes = 2;
+// Output voxels per tile along i, j, k: 16 K voxels, whose outputs (7 B each) and source stencils
+// take a few hundred KiB of the 1 MiB L2 (platform.md). Rows of 64 voxels keep each row's writes
+// to whole cache lines; 8 planes match the usual cube size, so a tetrahedron spans about two.
+constexpr Index3 kTile{64, 32, 8};
 
 /// One deformed tetrahedron, ready for containment tests.
 struct RefTet {
@@ -30,8 +35,14 @@ struct RefTet {
   Mat3 e_inv;                      // inverse of [x1−x0, x2−x0, x3−x0]
   Vec3 d0;                         // displacement of vertex 0
   Mat3 dd;                         // [d1−d0, d2−d0, d3−d0]
+  double w_step[4], w_step_inv[4];  // each weight's change per voxel along i, and its inverse (row spans)
   Index3 lo{0, 0, 0}, hi{-1, -1, -1};   // voxel centres of the bounding box (box-clipped, inclusive)
   Part part = Part::Wall;
+};
+
+/// A tile's voxel range, inclusive, in working-grid indices.
+struct Tile {
+  Index3 lo, hi;
 };
 
 RefTet prepare(const WarpMesh& m, int64_t t, const WarpBox& box) {
@@ -47,6 +58,9 @@ RefTet prepare(const WarpMesh& m, int64_t t, const WarpBox& box) {
   r.d0 = m.disp_ijk[v[0]];
   r.dd << m.disp_ijk[v[1]] - r.d0, m.disp_ijk[v[2]] - r.d0, m.disp_ijk[v[3]] - r.d0;
   r.part = m.tet_part[std::size_t(t)];
+  r.w_step[0] = -r.e_inv.col(0).sum();
+  for (int c = 0; c < 3; ++c) r.w_step[1 + c] = r.e_inv(c, 0);
+  for (int c = 0; c < 4; ++c) r.w_step_inv[c] = 1.0 / r.w_step[c];   // ±inf for 0: row_span looks at the sign first
   r.skip = false;
   for (int a = 0; a < 3; ++a) {
     double lo = x[0][a], hi = x[0][a];
@@ -60,27 +74,23 @@ RefTet prepare(const WarpMesh& m, int64_t t, const WarpBox& box) {
   return r;
 }
 
-/// The voxels of row (j, k) worth testing: where each barycentric weight, linear along the row, is
-/// ≥ −tolerance, widened by one voxel on each side so rounding in this estimate never drops a voxel
-/// the exact per-voxel test would take. Empty when first > last.
-std::pair<int64_t, int64_t> row_span(const RefTet& r, int64_t j, int64_t k) {
-  const Vec3 a = r.e_inv * (Vec3(double(r.lo[0]), double(j), double(k)) - r.x0);   // weights 1..3 at i = lo
-  const Vec3 b = r.e_inv.col(0);                                                   // their change per voxel
-  const double last = double(r.hi[0] - r.lo[0]);
-  double t_lo = 0.0, t_hi = last;
-  auto clip = [&](double ac, double bc) {   // ac + bc·t ≥ −tolerance
-    const double bound = (-kWarpTolerance - ac) / bc;
-    if (bc > 0) t_lo = std::max(t_lo, bound);
-    else if (bc < 0) t_hi = std::min(t_hi, bound);
-    else if (ac < -kWarpTolerance) t_hi = -1.0;
-  };
-  clip(1.0 - a.sum(), -b.sum());
-  for (int c = 0; c < 3; ++c) clip(a[c], b[c]);
-  if (!(t_lo <= t_hi + 2.0)) return {1, 0};
-  t_lo = std::clamp(t_lo, 0.0, last);
-  t_hi = std::clamp(t_hi, 0.0, last);
-  return {r.lo[0] + std::max<int64_t>(0, int64_t(std::ceil(t_lo)) - 1),
-          r.lo[0] + std::min<int64_t>(r.hi[0] - r.lo[0], int64_t(std::floor(t_hi)) + 1)};
+/// The voxels of a row from i_lo to i_hi inside tetrahedron r, given its weights 1..3 at i_lo. Along
+/// the row each barycentric weight is affine in i, w_c(i_lo + t) = w_c(i_lo) + t·step_c, so "every
+/// weight ≥ −tolerance" is an interval of t bounded by (−tolerance − w_c(i_lo)) / step_c: the
+/// containment test solved for the row at once instead of evaluated voxel by voxel. (The two differ
+/// only for a voxel whose weight lies within rounding, 1e-15 relative, of −tolerance: a tie by any
+/// reckoning.) Empty when first > last.
+std::pair<int64_t, int64_t> row_span(const RefTet& r, int64_t i_lo, int64_t i_hi, const Vec3& w_lo) {
+  const double w_first[4] = {1.0 - w_lo.sum(), w_lo[0], w_lo[1], w_lo[2]};
+  double t_lo = 0.0, t_hi = double(i_hi - i_lo);
+  for (int c = 0; c < 4; ++c) {   // w_first + w_step·t ≥ −tolerance
+    const double bound = (-kWarpTolerance - w_first[c]) * r.w_step_inv[c];
+    if (r.w_step[c] > 0) t_lo = std::max(t_lo, bound);
+    else if (r.w_step[c] < 0) t_hi = std::min(t_hi, bound);
+    else if (w_first[c] < -kWarpTolerance) t_hi = -1.0;
+  }
+  if (!(t_lo <= t_hi)) return {1, 0};   // also for NaN
+  return {i_lo + ceil_to_int(t_lo), i_lo + floor_to_int(t_hi)};
 }
 
 /// Whether each cube of row (j, k) was meshed at rest, indexed by cube_of_i[i]; null when the row
@@ -101,14 +111,18 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
 #pragma omp parallel for schedule(static)
   for (int64_t t = 0; t < T; ++t) tets[std::size_t(t)] = prepare(mesh, t, box);
 
-  const int64_t nz = box.dims[2];
-  const int64_t slabs = (nz + kSlabPlanes - 1) / kSlabPlanes;
-  std::vector<std::vector<int32_t>> by_slab(static_cast<std::size_t>(slabs));
+  Index3 tiles;
+  for (int a = 0; a < 3; ++a) tiles[a] = (box.dims[a] + kTile[a] - 1) / kTile[a];
+  const int64_t n_tiles = tiles[0] * tiles[1] * tiles[2];
+  auto tile_of = [&](int a, int64_t i) { return (i - box.lo[a]) / kTile[a]; };
+  std::vector<std::vector<int32_t>> by_tile(static_cast<std::size_t>(n_tiles));
   for (int64_t t = 0; t < T; ++t) {
     const RefTet& r = tets[std::size_t(t)];
     if (r.skip) continue;
-    for (int64_t s = (r.lo[2] - box.lo[2]) / kSlabPlanes; s <= (r.hi[2] - box.lo[2]) / kSlabPlanes; ++s)
-      by_slab[std::size_t(s)].push_back(int32_t(t));
+    for (int64_t c = tile_of(2, r.lo[2]); c <= tile_of(2, r.hi[2]); ++c)
+      for (int64_t b = tile_of(1, r.lo[1]); b <= tile_of(1, r.hi[1]); ++b)
+        for (int64_t a = tile_of(0, r.lo[0]); a <= tile_of(0, r.hi[0]); ++a)
+          by_tile[std::size_t(a + tiles[0] * (b + tiles[1] * c))].push_back(int32_t(t));
   }
 
   timer.lap("prepare");
@@ -118,89 +132,109 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
   const int64_t n_out = box.voxel_count();
   out.ct_hu.resize(std::size_t(n_out));
   if (src.labels) out.labels.resize(std::size_t(n_out));
-  out.outcome.resize(std::size_t(n_out));
+  out.outcome.resize(std::size_t(n_out), WarpOutcome::Kept);
 
-  const int64_t nx = box.dims[0], ny = box.dims[1], plane = nx * ny;
+  const int64_t nx = box.dims[0], ny = box.dims[1];
   // Cube column of each voxel column i (a table: an integer division per voxel costs more than the rest).
   std::vector<int64_t> cube_of_i(std::size_t(mesh.grid.dims[0]));
   for (int64_t i = 0; i < mesh.grid.dims[0]; ++i) cube_of_i[std::size_t(i)] = i / mesh.cube_voxels;
   timer.lap("allocate");
-  Progress progress("warp", slabs);
+  Progress progress("warp", n_tiles);
   std::atomic<int64_t> done{0};
-#pragma omp parallel
-  {
-    constexpr int32_t kNone = -1;
-    std::vector<int32_t> owner(std::size_t(plane * kSlabPlanes));
-    std::vector<uint8_t> covered(owner.size());
-    std::vector<Vec3> source(owner.size());
-#pragma omp for schedule(dynamic, 1)
-    for (int64_t s = 0; s < slabs; ++s) {
-      const int64_t k_begin = box.lo[2] + s * kSlabPlanes;
-      const int64_t k_end = std::min(k_begin + kSlabPlanes, box.lo[2] + nz);
-      std::fill(owner.begin(), owner.end(), kNone);
-      std::fill(covered.begin(), covered.end(), 0);
-      // 1. Scatter: every tetrahedron over its bounding box inside this slab, ascending index.
-      for (int32_t t : by_slab[std::size_t(s)]) {
-        const RefTet& r = tets[std::size_t(t)];
-        for (int64_t k = std::max(r.lo[2], k_begin); k <= std::min(r.hi[2], k_end - 1); ++k)
-          for (int64_t j = r.lo[1]; j <= r.hi[1]; ++j) {
-            const auto [i_begin, i_end] = row_span(r, j, k);
-            for (int64_t i = i_begin; i <= i_end; ++i) {
-              const Vec3 p = Vec3(double(i), double(j), double(k));
-              const Vec3 w = r.e_inv * (p - r.x0);
-              const double w0 = 1.0 - w[0] - w[1] - w[2];
-              if (w0 < -kWarpTolerance || w.minCoeff() < -kWarpTolerance) continue;
-              const int64_t n = (i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - k_begin));
-              covered[std::size_t(n)] = 1;
-              if (owner[std::size_t(n)] != kNone) continue;   // a lower index already accepted it
-              const Vec3 from = p - (r.d0 + r.dd * w);
-              const Role role = grid.role_nearest(from);
-              const bool accept = r.part == Part::Wall ? role != Role::Viscera : role != Role::Wall;
-              if (!accept) continue;
-              owner[std::size_t(n)] = t;
-              source[std::size_t(n)] = from;
-            }
-          }
+  int64_t carried = 0, gas = 0, kept = 0;
+  // The output voxel of working-grid index (i, j, k); its outcome doubles as the scatter's state:
+  // Kept = inside no tetrahedron yet, Gas = inside one that refused its source, Carried = taken
+  // (and sampled) by the first, so lowest-indexed, accepting one.
+  auto out_index = [&](int64_t i, int64_t j, int64_t k) {
+    return std::size_t((i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - box.lo[2])));
+  };
+  WarpOutcome* const outcome = out.outcome.data();
+  float* const hu = out.ct_hu.data();
+  uint16_t* const label = src.labels ? out.labels.data() : nullptr;
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : carried, gas, kept)
+  for (int64_t n_tile = 0; n_tile < n_tiles; ++n_tile) {
+    Tile tile;
+    const Index3 at{n_tile % tiles[0], (n_tile / tiles[0]) % tiles[1], n_tile / (tiles[0] * tiles[1])};
+    for (int a = 0; a < 3; ++a) {
+      tile.lo[a] = box.lo[a] + at[a] * kTile[a];
+      tile.hi[a] = std::min(tile.lo[a] + kTile[a], box.lo[a] + box.dims[a]) - 1;
+    }
+    // 1. Scatter and sample: every tetrahedron over its bounding box inside this tile, ascending
+    // index. The weights w and the source point P′ − (d₀ + D w) are affine in the voxel index, so
+    // each row starts from its value at the box's corner plus the row's offsets times its steps,
+    // and each voxel adds its offset along the row times the step along i. Equal displacements
+    // make D zero, so an identity or a whole-voxel translation still lands on whole voxels exactly.
+    for (int32_t t : by_tile[std::size_t(n_tile)]) {
+      const RefTet& r = tets[std::size_t(t)];
+      const Index3 lo{std::max(r.lo[0], tile.lo[0]), std::max(r.lo[1], tile.lo[1]), std::max(r.lo[2], tile.lo[2])};
+      const Index3 hi{std::min(r.hi[0], tile.hi[0]), std::min(r.hi[1], tile.hi[1]), std::min(r.hi[2], tile.hi[2])};
+      const Vec3 corner(static_cast<double>(lo[0]), static_cast<double>(lo[1]), static_cast<double>(lo[2]));
+      const Vec3 w_corner = r.e_inv * (corner - r.x0);
+      const Vec3 source_corner = corner - (r.d0 + r.dd * w_corner);
+      Vec3 w_along[3], source_along[3];   // per voxel along i, j, k
+      for (int a = 0; a < 3; ++a) {
+        w_along[a] = r.e_inv.col(a);
+        source_along[a] = Vec3::Unit(a) - r.dd * w_along[a];
       }
-      // 2. Sample, or decide gas / unchanged.
-      for (int64_t k = k_begin; k < k_end; ++k)
-        for (int64_t j = box.lo[1]; j < box.lo[1] + ny; ++j) {
-          const uint8_t* meshed_row = rest_row(mesh, j, k);
-          for (int64_t i = box.lo[0]; i < box.lo[0] + nx; ++i) {
-            const int64_t n = (i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - k_begin));
-            const int64_t o = (i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - box.lo[2]));
-            WarpOutcome what;
-            float hu;
-            uint16_t label = 0;
-            if (owner[std::size_t(n)] != kNone) {
-              what = WarpOutcome::Carried;
-              const Vec3& from = source[std::size_t(n)];
-              hu = float(grid.ct_trilinear(from));
-              if (src.labels) label = grid.label_nearest(from);
-            } else if (covered[std::size_t(n)] || (meshed_row && meshed_row[cube_of_i[std::size_t(i)]])) {
-              what = WarpOutcome::Gas;
-              hu = opt.gas_hu;
-              label = opt.cavity_label;
-            } else {
-              what = WarpOutcome::Kept;
-              const int64_t v = mesh.grid.linear_index(i, j, k);
-              hu = src.ct_hu[v];
-              if (src.labels) label = src.labels[v];
+      for (int64_t k = lo[2]; k <= hi[2]; ++k)
+        for (int64_t j = lo[1]; j <= hi[1]; ++j) {
+          const double dj = double(j - lo[1]), dk = double(k - lo[2]);
+          const Vec3 w_row = w_corner + dj * w_along[1] + dk * w_along[2];
+          const auto [first, last] = row_span(r, lo[0], hi[0], w_row);
+          if (first > last) continue;
+          const double di = double(first - lo[0]);
+          const Vec3 source0 = source_corner + di * source_along[0] + dj * source_along[1] + dk * source_along[2];
+          const std::size_t row = out_index(first, j, k);
+          for (int64_t step = 0; step <= last - first; ++step) {
+            const std::size_t n = row + std::size_t(step);
+            if (outcome[n] == WarpOutcome::Carried) continue;   // a lower index already took it
+            const Vec3 from = source0 + double(step) * source_along[0];
+            const int64_t v = grid.nearest(from);
+            const Role role = v < 0 ? Role::Other : src.roles[v];
+            if (r.part == Part::Wall ? role == Role::Viscera : role == Role::Wall) {
+              outcome[n] = WarpOutcome::Gas;   // covered; gas unless a later tetrahedron accepts it
+              continue;
             }
-            out.outcome[std::size_t(o)] = what;
-            out.ct_hu[std::size_t(o)] = hu;
-            if (src.labels) out.labels[std::size_t(o)] = label;
+            outcome[n] = WarpOutcome::Carried;
+            hu[n] = v < 0 ? float(SourceGrid::kOutsideHu) : float(grid.ct_trilinear_inside(from));
+            if (label) label[n] = v < 0 ? uint16_t(0) : src.labels[v];
           }
         }
-      const int64_t d = ++done;
-      if (omp_get_thread_num() == 0) progress.update(d);
     }
+    // 2. What no tetrahedron took: gas inside the meshes' space before or after deformation,
+    // otherwise the voxel's own value.
+    for (int64_t k = tile.lo[2]; k <= tile.hi[2]; ++k)
+      for (int64_t j = tile.lo[1]; j <= tile.hi[1]; ++j) {
+        const uint8_t* meshed_row = rest_row(mesh, j, k);
+        const std::size_t row = out_index(tile.lo[0], j, k);
+        const int64_t v_row = mesh.grid.linear_index(0, j, k);
+        for (int64_t i = tile.lo[0]; i <= tile.hi[0]; ++i) {
+          const std::size_t n = row + std::size_t(i - tile.lo[0]);
+          WarpOutcome& what = outcome[n];
+          if (what == WarpOutcome::Carried) {
+            ++carried;
+            continue;
+          }
+          if (what == WarpOutcome::Kept && meshed_row && meshed_row[cube_of_i[std::size_t(i)]]) what = WarpOutcome::Gas;
+          if (what == WarpOutcome::Gas) {
+            ++gas;
+            hu[n] = opt.gas_hu;
+            if (label) label[n] = opt.cavity_label;
+          } else {
+            ++kept;
+            hu[n] = src.ct_hu[v_row + i];
+            if (label) label[n] = src.labels[v_row + i];
+          }
+        }
+      }
+    const int64_t d = ++done;
+    if (omp_get_thread_num() == 0) progress.update(d);
   }
   progress.finish();
+  out.carried_voxels = carried;
+  out.gas_voxels = gas;
+  out.kept_voxels = kept;
   timer.lap("scatter and sample");
-  for (WarpOutcome w : out.outcome)
-    ++(w == WarpOutcome::Carried ? out.carried_voxels : w == WarpOutcome::Gas ? out.gas_voxels : out.kept_voxels);
-  timer.lap("count");
   return out;
 }
 

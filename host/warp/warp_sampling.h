@@ -16,6 +16,19 @@
 
 namespace pneumo {
 
+/// floor and ceil to an integer, exact for |x| < 2^53. Without SSE4.1 in the target (the default
+/// x86-64 build) std::floor and std::ceil are calls into libm, and the warp takes up to eight per
+/// voxel; the cast truncates toward zero in one instruction, and one comparison turns that into
+/// floor or ceil.
+inline int64_t floor_to_int(double x) {
+  const int64_t i = int64_t(x);
+  return double(i) > x ? i - 1 : i;
+}
+inline int64_t ceil_to_int(double x) {
+  const int64_t i = int64_t(x);
+  return double(i) < x ? i + 1 : i;
+}
+
 struct SourceGrid {
   Index3 dims;
   const float* ct_hu = nullptr;
@@ -28,9 +41,10 @@ struct SourceGrid {
   int64_t nearest(const Vec3& p) const {
     int64_t n[3];
     for (int a = 0; a < 3; ++a) {
-      const double f = std::floor(p[a] + 0.5);
-      if (!(f >= 0.0 && f < double(dims[a]))) return -1;   // also false for NaN
-      n[a] = int64_t(f);
+      // floor(p + ½) lies in [0, n) exactly when p + ½ does; there the cast is the floor.
+      const double q = p[a] + 0.5;
+      if (!(q >= 0.0 && q < double(dims[a]))) return -1;   // also false for NaN
+      n[a] = int64_t(q);
     }
     return n[0] + dims[0] * (n[1] + dims[1] * n[2]);
   }
@@ -42,24 +56,40 @@ struct SourceGrid {
     const int64_t v = nearest(p);
     return v < 0 || !labels ? uint16_t(0) : labels[v];
   }
-  double ct_trilinear(const Vec3& p) const {
-    if (nearest(p) < 0) return kOutsideHu;
-    int64_t i0[3], i1[3];
+  double ct_trilinear(const Vec3& p) const { return nearest(p) < 0 ? kOutsideHu : ct_trilinear_inside(p); }
+  /// ct_trilinear at a point known to be inside (nearest(p) ≥ 0): the warp has just looked.
+  double ct_trilinear_inside(const Vec3& p) const {
+    // Away from the grid's far faces and at or past its near ones (nearly every voxel the warp
+    // samples), the stencil needs no clamping and truncation is the floor.
+    const int64_t i = int64_t(p[0]), j = int64_t(p[1]), k = int64_t(p[2]);
+    if (p[0] >= 0.0 && p[1] >= 0.0 && p[2] >= 0.0 && i < dims[0] - 1 && j < dims[1] - 1 && k < dims[2] - 1)
+      return trilinear(ct_hu + i + dims[0] * (j + dims[1] * k), 1, dims[0], dims[0] * dims[1],
+                       p[0] - double(i), p[1] - double(j), p[2] - double(k));
+    // The stencil's corner and its step to the +1 neighbour on each axis: zero where the neighbour
+    // is clamped to the edge voxel.
+    int64_t corner[3], step[3];
     double f[3];
+    const int64_t stride[3] = {1, dims[0], dims[0] * dims[1]};
     for (int a = 0; a < 3; ++a) {
-      const double fl = std::floor(p[a]);
-      f[a] = p[a] - fl;
-      i0[a] = std::clamp<int64_t>(int64_t(fl), 0, dims[a] - 1);
-      i1[a] = std::clamp<int64_t>(int64_t(fl) + 1, 0, dims[a] - 1);
+      const int64_t i = floor_to_int(p[a]);
+      f[a] = p[a] - double(i);
+      const int64_t i0 = std::clamp<int64_t>(i, 0, dims[a] - 1), i1 = std::clamp<int64_t>(i + 1, 0, dims[a] - 1);
+      corner[a] = i0 * stride[a];
+      step[a] = (i1 - i0) * stride[a];
     }
-    auto at = [&](int64_t i, int64_t j, int64_t k) { return double(ct_hu[i + dims[0] * (j + dims[1] * k)]); };
-    const double c00 = at(i0[0], i0[1], i0[2]) * (1 - f[0]) + at(i1[0], i0[1], i0[2]) * f[0];
-    const double c10 = at(i0[0], i1[1], i0[2]) * (1 - f[0]) + at(i1[0], i1[1], i0[2]) * f[0];
-    const double c01 = at(i0[0], i0[1], i1[2]) * (1 - f[0]) + at(i1[0], i0[1], i1[2]) * f[0];
-    const double c11 = at(i0[0], i1[1], i1[2]) * (1 - f[0]) + at(i1[0], i1[1], i1[2]) * f[0];
-    const double c0 = c00 * (1 - f[1]) + c10 * f[1];
-    const double c1 = c01 * (1 - f[1]) + c11 * f[1];
-    return c0 * (1 - f[2]) + c1 * f[2];
+    return trilinear(ct_hu + corner[0] + corner[1] + corner[2], step[0], step[1], step[2], f[0], f[1], f[2]);
+  }
+
+ private:
+  /// The stencil at corner c with neighbours x, y, z elements away, at fractions (fx, fy, fz).
+  static double trilinear(const float* c, int64_t x, int64_t y, int64_t z, double fx, double fy, double fz) {
+    const double c00 = double(c[0]) * (1 - fx) + double(c[x]) * fx;
+    const double c10 = double(c[y]) * (1 - fx) + double(c[y + x]) * fx;
+    const double c01 = double(c[z]) * (1 - fx) + double(c[z + x]) * fx;
+    const double c11 = double(c[z + y]) * (1 - fx) + double(c[z + y + x]) * fx;
+    const double c0 = c00 * (1 - fy) + c10 * fy;
+    const double c1 = c01 * (1 - fy) + c11 * fy;
+    return c0 * (1 - fz) + c1 * fz;
   }
 };
 
