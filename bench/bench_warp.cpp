@@ -20,7 +20,7 @@
 //   bandwidth_gb_s      STREAM triad in this process, same device and threads (1 GB = 1e9 bytes)
 //   roofline_fraction   voxels_per_s / (bandwidth / bytes_per_voxel)
 //   other_cores         CPU (in cores) other processes used meanwhile; above ~0.1 the run was contended
-//   x_vtk, x_itk        voxels_per_s over the peers measured on this machine (../shared/peers/RESULTS-2026-11.md):
+//   x_vtk, x_itk        voxels_per_s over the peers measured on the reference machine (common/warp_cost.h):
 //                       VTK vtkProbeFilter pull-back 1.04 Mvoxel/s, ITK dense-field resampling 29.5 Mvoxel/s
 //
 // Bytes per output voxel: common/warp_cost.h (shared with `pneumo bench`).

@@ -11,7 +11,9 @@ namespace pneumo::bench {
 constexpr double kWarpCpuBytesPerVoxel = 4 + 1 + 2 + 4 + 2 + 1;
 constexpr double kWarpClBytesPerVoxel = kWarpCpuBytesPerVoxel + 12 + 28;
 
-// Peers measured on this machine (../shared/peers/RESULTS-2026-11.md), for the x_vtk and x_itk ratios.
+// Peers measured on the project's reference machine (AMD EPYC Zen 4, 2 cores: ../shared/peers/RESULTS-2026-11.md), for
+// the x_vtk and x_itk ratios: a guide on that machine only. Elsewhere compare with bench/peers/compare_warp.sh, which
+// times the peers and pneumo in one run on the same case.
 constexpr double kVtkWarpVoxelsPerS = 1.04e6;   // warp_probe probe_mvox_per_s (vtkProbeFilter pull-back)
 constexpr double kItkWarpVoxelsPerS = 29.5e6;   // itk_double_file mvox_per_s_median (2 threads)
 

@@ -12,6 +12,12 @@ Reads what bench/peers/compare_warp.sh left in DIR:
   pneumo/warped_opencl.mhd          pneumo, OpenCL (float32 HU)
   pneumo/outcome.mhd                pneumo's outcome per voxel (0 kept, 1 carried, 2 gas)
   pneumo/disp_pneumo.mhd            pneumo's field through its PointMap, same convention as disp.mhd
+  vtk_tetwarp.jsonl                 VTK's timings (its last line): total_probe_plus_mapcoords_s is the whole pipeline
+  itk_warp.txt                      ITK's RESULT line through VTK's field: resample_s_median
+  pneumo_peer_warp.json             pneumo's timings (pneumo bench --peer-warp): the median warp per device
+
+Speeds are compared only within this run, on this machine: each peer's whole job against pneumo's whole warp
+(scatter, sample, gas rule; read and write excluded for all).
 
 "Where both are defined": pneumo carried the voxel (a deformed tetrahedron holds it) and its source point's trilinear
 stencil lies inside the volume, so no tool's convention for samples beyond the last voxel centre enters (VTK's
@@ -37,6 +43,40 @@ def stats(a, b, mask):
     return dict(voxels=n, max_abs=float(d.max()), mean_abs=float(d.mean()),
                 frac_gt_0_5=float((d > 0.5).mean()), frac_gt_1=float((d > 1.0).mean()),
                 n_gt_1=int((d > 1.0).sum()))
+
+
+def speeds(d, voxels):
+    """Seconds of each whole job in this run, from the logs compare_warp.sh leaves (missing ones are left out)."""
+    out = {}
+    try:
+        with open(os.path.join(d, "vtk_tetwarp.jsonl")) as f:
+            vtk = json.loads(f.read().strip().splitlines()[-1])
+        out["vtk_pipeline"] = vtk["total_probe_plus_mapcoords_s"]
+        out["vtk_probe"] = vtk["probe_s"]
+    except (OSError, IndexError, KeyError, ValueError):
+        pass
+    try:
+        with open(os.path.join(d, "itk_warp.txt")) as f:
+            line = [l for l in f if l.startswith("RESULT ")][-1]
+        itk = json.loads(line[len("RESULT "):])
+        out["itk_resample"] = itk["resample_s_median"]
+        out["itk_threads"] = itk["threads"]
+    except (OSError, IndexError, KeyError, ValueError):
+        pass
+    try:
+        with open(os.path.join(d, "pneumo_peer_warp.json")) as f:
+            pn = json.load(f)
+        for w in pn["warps"]:
+            key = "pneumo_cpu" if w["device"] == "cpu" else "pneumo_opencl"
+            out[key] = w["seconds"]
+            out[key + "_other_cores_max"] = w.get("other_cores_max")
+    except (OSError, KeyError, ValueError):
+        pass
+    for dev in ("pneumo_cpu", "pneumo_opencl"):
+        for peer in ("vtk_pipeline", "itk_resample"):
+            if dev in out and peer in out:
+                out["%s_x_%s" % (dev, peer)] = round(out[peer] / out[dev], 2)
+    return out
 
 
 def main():
@@ -113,6 +153,7 @@ def main():
         rec["field_mm_pneumo_vs_vtk"] = dict(voxels=int(both.sum()), max_abs=float(d[both].max()),
                                              mean_abs=float(d[both].mean()),
                                              max_abs_all_carried=float(d[carried].max()))
+    rec["speed"] = speeds(a.dir, int(src.size))
     text = json.dumps(rec, indent=2)
     print(text)
     if a.json:
@@ -136,6 +177,20 @@ def main():
         if "opencl_vs_cpu_hu" in rec:
             lines.append("pneumo OpenCL against its CPU reference, every voxel: max |Δ| %.4f HU." %
                          rec["opencl_vs_cpu_hu"]["max_abs"])
+        sp_ = rec["speed"]
+        if sp_:
+            lines.append("\nSpeed in this run (%d voxels; s, and pneumo's multiple of each peer's rate):\n" % src.size)
+            lines.append("| job | seconds | voxels/s | pneumo CPU is | pneumo OpenCL is |")
+            lines.append("|---|---|---|---|---|")
+            for key, label in (("vtk_pipeline", "VTK probe + map_coordinates"), ("itk_resample", "ITK resampling"),
+                               ("pneumo_cpu", "pneumo warp, CPU reference"), ("pneumo_opencl", "pneumo warp, OpenCL")):
+                if key not in sp_:
+                    continue
+                s_ = sp_[key]
+                row = "| %s | %.2f | %.1f M |" % (label, s_, src.size / s_ / 1e6)
+                for dev in ("pneumo_cpu", "pneumo_opencl"):
+                    row += (" %.1fx |" % (s_ / sp_[dev])) if dev in sp_ and not key.startswith("pneumo") else " |"
+                lines.append(row)
         with open(a.markdown + ".tmp", "w") as f:
             f.write("\n".join(lines) + "\n")
         os.replace(a.markdown + ".tmp", a.markdown)

@@ -4,7 +4,9 @@
 #
 #   bash bench/peers/compare_warp.sh WORKDIR     # ~5 min on 2 cores, ~3 GB of volumes in WORKDIR
 #
-# Results: WORKDIR/compare_warp.{json,md}; the volumes stay in WORKDIR for a look (3D Slicer opens .mhd).
+# Results: WORKDIR/compare_warp.{json,md}, the values voxel by voxel and the speeds measured in this run (VTK's
+# pipeline, ITK's resampling, pneumo's warp, medians of 3 where the tool repeats); the volumes stay in WORKDIR for
+# a look (3D Slicer opens .mhd).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 work=${1:?usage: bash bench/peers/compare_warp.sh WORKDIR}
@@ -20,14 +22,16 @@ work=$(cd "$work" && pwd)
 
 [ -f "$work/phantom.mhd" ] || "$py" "$peers/phantom.py" "$work"
 echo "compare_warp: VTK (vtkProbeFilter pull-back, ~80 s)" >&2
+rm -f "$work/vtk_tetwarp.jsonl"
 "$py" "$peers/vtk_tetwarp.py" "$work" --resample mapcoords,reslice --write-field --write-warped \
   --log "$work/vtk_tetwarp.jsonl"
 cmake -S "$peers" -B "$work/itk-build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$work/itk-build" --target itk_warp >/dev/null
 echo "compare_warp: pneumo on the same mesh and lift" >&2
-build/pneumo bench --peer-warp "$work" > "$work/pneumo_peer_warp.json"
+build/pneumo bench --peer-warp "$work" --repeats 3 > "$work/pneumo_peer_warp.json"
 echo "compare_warp: ITK through VTK's field and through pneumo's" >&2
-"$work/itk-build/itk_warp" "$work/phantom.mhd" "$work/disp.mhd" --out "$work/warped_itk.mhd" --repeats 1
+"$work/itk-build/itk_warp" "$work/phantom.mhd" "$work/disp.mhd" --out "$work/warped_itk.mhd" --repeats 3 |
+  tee "$work/itk_warp.txt"
 "$work/itk-build/itk_warp" "$work/phantom.mhd" "$work/pneumo/disp_pneumo.mhd" \
   --out "$work/warped_itk_pneumo_field.mhd" --repeats 1
 "$py" bench/peers/compare_warp.py "$work" "$peers" --json "$work/compare_warp.json" --markdown "$work/compare_warp.md"

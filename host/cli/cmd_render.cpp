@@ -37,8 +37,7 @@ Run add_render(CLI::App& app) {
         std::filesystem::exists(std::filesystem::path(o->out) / "deformation.bin")) {
       deformed = std::make_unique<DeformedMesh>(load_deformed_mesh(scene, o->out));
       point_map = std::make_unique<PointMap>(deformed->point_map());
-      const PointMap* pm = point_map.get();
-      opt.map_point = [pm](const Vec3& p) -> Vec3 { return pm->to_deformed(p).point_mm; };
+      opt.map_point = deformed_point_fn(*point_map);
     }
     const RenderRun run = render_scene(scene, opt);
     const auto& rj = run.report["render"];

@@ -131,7 +131,7 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
                                    std::move(sim.roles), std::move(sim.mesh), std::move(solved));
   write_warp(scene, w, o.out_dir);
   const PointMap point_map = w.point_map();
-  const PointMapFn map = [&point_map](const Vec3& p) -> Vec3 { return point_map.to_deformed(p).point_mm; };
+  const PointMapFn map = deformed_point_fn(point_map);
 
   log::info("stage 3/4: render");
   const auto t_render = std::chrono::steady_clock::now();

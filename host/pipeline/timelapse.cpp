@@ -59,7 +59,7 @@ void Timelapse::frame(const SolverSnapshot& snapshot) {
   const fs::path scratch = fs::path(out_dir_) / "timelapse" / ".frame";
   ro.out_dir = scratch.string();
   ro.backend = backend_;
-  ro.map_point = [&point_map](const Vec3& p) -> Vec3 { return point_map.to_deformed(p).point_mm; };
+  ro.map_point = deformed_point_fn(point_map, false);   // the final render says it once
   RenderRun run;
   run.deformed = true;
   run.ct_path = "(warped at step " + std::to_string(snapshot.step) + ")";

@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "core/log.h"
 
 #include "warp/warp_sampling.h"
 
@@ -42,7 +46,7 @@ PointMap::Bins PointMap::bin(bool deformed) const {
   for (int pass = 0; pass < 2; ++pass) {   // count, then fill (ascending ids per cell)
     std::vector<int64_t> fill(b.start.begin(), b.start.end() - 1);
     for (int64_t t = 0; t < T; ++t) {
-      if (deformed && !usable_[std::size_t(t)]) continue;
+      if (!usable_[std::size_t(t)]) continue;   // the warp skips them too, before and after
       Index3 c0, c1;
       cell_range(t, c0, c1);
       for (int64_t z = c0[2]; z <= c1[2]; ++z)
@@ -109,5 +113,19 @@ MappedPoint PointMap::map(const Vec3& mm, bool forward) const {
 
 MappedPoint PointMap::to_deformed(const Vec3& original_mm) const { return map(original_mm, true); }
 MappedPoint PointMap::to_original(const Vec3& deformed_mm) const { return map(deformed_mm, false); }
+
+PointMapFn deformed_point_fn(const PointMap& map, bool warn) {
+  return [&map, warn](const Vec3& p) -> Vec3 {
+    const MappedPoint m = map.to_deformed(p);
+    if (!m.carried && warn) {
+      char at[96];
+      std::snprintf(at, sizeof at, "(%.1f, %.1f, %.1f) mm", p[0], p[1], p[2]);
+      log::warn(std::string("the point ") + at + " lies in no tetrahedron that carries it (outside the wall and "
+                "viscera meshes, or in tissue its tetrahedra refuse): it keeps its CT position while the tissue "
+                "around it moves");
+    }
+    return m.point_mm;
+  };
+}
 
 }  // namespace pneumo

@@ -51,4 +51,10 @@ class PointMap {
   Bins rest_, deformed_;
 };
 
+/// The map as the renderer and the landmark evaluation take it (original CT mm → deformed mm). A
+/// point that no tetrahedron carries keeps its position; with `warn` each such point is logged,
+/// since a port's skin point or a landmark outside the meshes does not follow the tissue around it.
+/// `map` must outlive the function.
+PointMapFn deformed_point_fn(const PointMap& map, bool warn = true);
+
 }  // namespace pneumo

@@ -110,6 +110,7 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
   std::vector<RefTet> tets(static_cast<std::size_t>(T));
 #pragma omp parallel for schedule(static)
   for (int64_t t = 0; t < T; ++t) tets[std::size_t(t)] = prepare(mesh, t, box);
+  timer.lap("tetrahedra");
 
   Index3 tiles;
   for (int a = 0; a < 3; ++a) tiles[a] = (box.dims[a] + kTile[a] - 1) / kTile[a];
@@ -125,7 +126,7 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
           by_tile[std::size_t(a + tiles[0] * (b + tiles[1] * c))].push_back(int32_t(t));
   }
 
-  timer.lap("prepare");
+  timer.lap("tiles");
   const SourceGrid grid{mesh.grid.dims, src.ct_hu, src.labels, src.roles};
   WarpResult out;
   out.device = "cpu";
