@@ -3,7 +3,9 @@
 #include <sys/wait.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -21,6 +23,15 @@ inline std::string slurp(const std::string& path) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+/// Every path under `root`, relative, sorted (hidden temporary files included): what a command that
+/// must write nothing is compared by, before and after.
+inline std::set<std::string> tree(const std::filesystem::path& root) {
+  std::set<std::string> out;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(root))
+    out.insert(std::filesystem::relative(e.path(), root).string());
+  return out;
 }
 
 /// `pneumo ARGS` with no standard input; its output goes through files in a scratch folder.

@@ -154,17 +154,30 @@ TEST_P(PerDevice, IncludesAreExpandedFromEmbeddedKernels) {
 }
 
 TEST_P(PerDevice, ACaseTooLargeIsRefusedBeforeAllocatingWithTheEstimate) {
+  // Compared: the message against the estimate passed in and the device's limit, both in MiB rounded
+  // up, for a case larger than the device's memory and for one buffer larger than it allows.
+  // (DeviceMemoryEstimate checks that the estimates cover what is then allocated.)
   auto c = ctx();
-  const uint64_t too_much = c->info().global_mem_bytes + (1ull << 30);
+  auto mib = [](uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; };
+  const uint64_t too_much = c->info().global_mem_bytes + (1ull << 30) + 12345;
   try {
     c->check_fits(too_much, 1 << 20, "the test case");
     FAIL();
   } catch (const InputError& e) {
     const std::string msg = e.what();
     EXPECT_NE(msg.find(c->info().name), std::string::npos) << msg;
-    EXPECT_NE(msg.find("MiB"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("the test case needs about " + mib(too_much)), std::string::npos) << msg;
+    EXPECT_NE(msg.find(mib(c->info().global_mem_bytes)), std::string::npos) << msg;
   }
-  EXPECT_THROW(c->check_fits(1 << 20, c->info().max_alloc_bytes + 1, "one buffer"), InputError);
+  const uint64_t too_large_buffer = c->info().max_alloc_bytes + (3u << 20);
+  try {
+    c->check_fits(too_large_buffer, too_large_buffer, "one buffer");
+    FAIL();
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("one buffer needs a single buffer of " + mib(too_large_buffer)), std::string::npos) << msg;
+    EXPECT_NE(msg.find(mib(c->info().max_alloc_bytes)), std::string::npos) << msg;
+  }
   EXPECT_NO_THROW(c->check_fits(1 << 20, 1 << 20, "a small case"));
 }
 

@@ -10,8 +10,10 @@
 #include <omp.h>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "core/error.h"
@@ -21,6 +23,9 @@
 #include "solve/forces.h"
 #include "solve/solvable.h"
 #include "solve/solver.h"
+#include "solve/solver_cl.h"
+
+#include "opencl_test_support.h"
 
 namespace pneumo {
 namespace {
@@ -466,6 +471,59 @@ TEST(ExtremeInversion, InvertedTetrahedraAreCountedReportedAndStopTheRunWhenAske
                 (long long)went_on.inverted_tetrahedra, (long long)went_on.steps);
   }
 }
+
+/// A solver (method) on a device: "cpu" for the C++ reference or an OpenCL spec.
+using SolverOnDevice = std::tuple<SolverMethod, std::string>;
+
+class ExtremeInversionOn : public ::testing::TestWithParam<SolverOnDevice> {};
+
+TEST_P(ExtremeInversionOn, TheSoftSlabInvertsAndTheRunStopsOrGoesOnAsTold) {
+  // Compared: ExtremeInversion's soft slab (E = 3 kPa under 12 mmHg) through every solver on every device.
+  // With solver.on_inverted = stop the run must stop on its own account: "inverted tetrahedra", not
+  // converged, a count > 0 equal to count_inverted of the positions it returns (on a device, the
+  // device's positions: the count and the shape must agree). With continue, given twice those steps, it
+  // must go past the step the stopped run ended at ("converged" or "step limit", never "inverted
+  // tetrahedra"), count its own final positions (still > 0 under this load) and warn with the count.
+  const auto& [method, device] = GetParam();
+  const OneThread one;
+  const Mesh m = slab({1, 3e3});
+  std::shared_ptr<ocl::Context> ctx;
+  if (device != "cpu") ctx = ocl::Context::shared(ocl::parse_device_spec(device));
+  auto run = [&](OnInverted on_inverted, int64_t max_steps) {
+    SolveOptions o = quiet(method, 12.0);
+    o.on_inverted = on_inverted;
+    o.max_steps = max_steps;
+    return ctx ? solve_opencl(*ctx, m, o) : solve(m, o);
+  };
+  const SolveResult stopped = run(OnInverted::Stop, 100000);
+  EXPECT_EQ(stopped.stop_reason, "inverted tetrahedra");
+  EXPECT_FALSE(stopped.converged);
+  EXPECT_GT(stopped.inverted_tetrahedra, 0);
+  EXPECT_EQ(stopped.inverted_tetrahedra, count_inverted(m, stopped.x));
+  ::testing::internal::CaptureStderr();
+  const SolveResult went_on = run(OnInverted::Continue, 2 * stopped.steps);
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(went_on.stop_reason, "inverted tetrahedra");
+  EXPECT_GT(went_on.steps, stopped.steps);
+  EXPECT_GT(went_on.inverted_tetrahedra, 0);
+  EXPECT_EQ(went_on.inverted_tetrahedra, count_inverted(m, went_on.x));
+  EXPECT_NE(log.find(std::to_string(went_on.inverted_tetrahedra) + " of " + std::to_string(m.tets.size()) +
+                     " tetrahedra are inverted"),
+            std::string::npos)
+      << log;
+  std::printf("%s on %s: stopped after %lld steps with %lld inverted; continue: %s after %lld steps, %lld inverted\n",
+              enum_name(method), device.c_str(), (long long)stopped.steps, (long long)stopped.inverted_tetrahedra,
+              went_on.stop_reason.c_str(), (long long)went_on.steps, (long long)went_on.inverted_tetrahedra);
+}
+
+INSTANTIATE_TEST_SUITE_P(EverySolver, ExtremeInversionOn,
+                         ::testing::Combine(::testing::Values(SolverMethod::Static, SolverMethod::Explicit,
+                                                              SolverMethod::Newmark, SolverMethod::Kitasaka2004),
+                                            ::testing::ValuesIn(testing_support::cpu_and_opencl_device_specs())),
+                         [](const ::testing::TestParamInfo<SolverOnDevice>& info) {
+                           return std::string(enum_name(std::get<0>(info.param))) + "_" +
+                                  testing_support::spec_name(std::get<1>(info.param));
+                         });
 
 TEST(ExtremeNewmark, InnerLoopCappedWhileConvergingAsksForMoreIterationsNotASmallerStep) {
   // Compared: Newmark at half the stable estimate (its inner loop contracts) but allowed only 2 inner

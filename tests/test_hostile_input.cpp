@@ -1,12 +1,16 @@
-// Issue 9, hostile input end to end: `pneumo simulate` on a tiny case (tiny_case_support.h) with one
-// piece spoiled at a time (a truncated or corrupt volume, an absurd header, NaN or Inf voxels, labels
-// off the CT's grid, a mapping for another label map, scene keys of the wrong type or unit, missing or
-// unwritable paths, roles that leave nothing to move or a wall unanchored). Compared, for each row:
-// the exit code (2 = bad input; 1 for a run that diverges, which is pneumo stopping, with advice, on a
-// scene that was valid), stderr is exactly one line holding the expected words (the file or key and
-// what to change), stdout holds nothing, and nothing was written: the folder holds exactly the files
-// the row wrote, and no output folder exists. The unspoiled case must succeed (the control row), so
-// every refusal is the spoiled piece's doing.
+// Issue 9, hostile input end to end: a tiny case (tiny_case_support.h) with one piece spoiled at a
+// time (a truncated or corrupt volume, an absurd header, NaN or Inf voxels, labels off the CT's grid, a
+// mapping for another label map, scene keys of the wrong type or unit, missing or unwritable paths,
+// roles that leave nothing to move or a wall unanchored, a load that turns tetrahedra inside out with
+// solver.on_inverted = "stop"), run through each command that reads that piece: `pneumo simulate`,
+// `run`, `render` and `warp` (warp into the folder of the unspoiled case's simulation). Compared, for
+// each row and command: the exit code (2 = bad input; 1 for a run that diverges or stops, which is
+// pneumo stopping, with advice, on a scene that was valid), stderr is exactly one line holding the
+// expected words (the file or key and what to change), stdout holds nothing, and nothing was written:
+// the folder holds exactly the files it held before the command, and no output folder appeared. The
+// unspoiled case must succeed through every command (the control rows), so every refusal is the
+// spoiled piece's doing. A forced `run` over an earlier run's results with a spoiled input must leave
+// those results byte for byte.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,8 +18,10 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <map>
 #include <ostream>
 #include <set>
+#include <stdexcept>
 
 #include "cli_test_support.h"
 #include "tiny_case_support.h"
@@ -25,14 +31,6 @@ namespace {
 
 using namespace testing_support;
 using json = nlohmann::json;
-
-/// Every path under `root`, relative, sorted (hidden temporary files included).
-std::set<std::string> tree(const std::filesystem::path& root) {
-  std::set<std::string> out;
-  for (const auto& e : std::filesystem::recursive_directory_iterator(root))
-    out.insert(std::filesystem::relative(e.path(), root).string());
-  return out;
-}
 
 /// The tiny case with the CT written as MetaImage (ct.mha), its header passed through `edit`.
 std::string with_mha_ct(const ScratchDir& d, const std::function<std::string(std::string)>& edit) {
@@ -69,12 +67,21 @@ std::string with_scene(const ScratchDir& d, const std::string& pointer, const js
   return write_tiny_case(d, s);
 }
 
+/// The commands a row goes through: each reads the spoiled piece. Render builds no roles or mesh;
+/// warp needs the case's own simulation in --out; only simulate and run solve; only warp and run
+/// mark the cavity in the labels.
+const std::vector<std::string> kEveryCommand = {"simulate", "run", "render", "warp"};
+const std::vector<std::string> kRolesCommands = {"simulate", "run", "warp"};
+const std::vector<std::string> kMeshCommands = {"simulate", "run"};
+const std::vector<std::string> kFolderCommands = {"simulate", "run", "render"};
+
 struct Row {
   std::string name;
   std::function<std::string(const ScratchDir&)> make;   // writes the case, returns the scene path
   std::vector<std::string> expected;                     // substrings of the one error line
   int code = 2;
   std::string out = "out";                               // the --out folder, relative to the case
+  std::vector<std::string> commands = kEveryCommand;
 };
 
 std::vector<Row> rows() {
@@ -88,7 +95,7 @@ std::vector<Row> rows() {
          write_bytes(d.file("ct.nii.gz"), bytes.substr(0, bytes.size() / 2));
          return scene;
        },
-       {"ct.nii.gz: ", "truncated"}},
+       {"ct.nii.gz: ", "too short for a NIfTI-1 header"}},
       {"ct_corrupt_metaimage",
        [](D d) { return with_mha_ct(d, [](std::string) { return std::string("\x89PNG\r\n\x1a\n garbage\n"); }); },
        {"ct.mha: ", "not a MetaImage header"}},
@@ -120,9 +127,9 @@ std::vector<Row> rows() {
        },
        {"ct.nii: ", "sform", "not finite"}},
       {"ct_nan_voxel", [nan](D d) { return with_ct_voxel(d, nan); },
-       {"ct.nii.gz: ", "1 voxels are NaN or infinite", "(5, 6, 4)", "-1000 HU"}},
+       {"ct.nii.gz: ", "1 voxels are NaN or infinite", "(5, 6, 4)", "-1000 HU"}, 2, "out", kRolesCommands},
       {"ct_infinite_voxel", [inf](D d) { return with_ct_voxel(d, -inf); },
-       {"ct.nii.gz: ", "NaN or infinite", "(5, 6, 4)"}},
+       {"ct.nii.gz: ", "NaN or infinite", "(5, 6, 4)"}, 2, "out", kRolesCommands},
       {"labels_on_another_grid",
        [](D d) {
          Volume labels = tiny_case_labels();
@@ -143,7 +150,7 @@ std::vector<Row> rows() {
        },
        {"labels.nii.gz: ", "label value 2.5", "whole numbers"}},
       {"mapping_for_another_label_map", [](D d) { return with_scene(d, "/roles/viscera_labels", {17, 18}); },
-       {"labels.nii.gz: ", "roles.viscera_labels (17, 18)", "its ids: 1, 2, 3"}},
+       {"labels.nii.gz: ", "roles.viscera_labels (17, 18)", "its ids: 1, 2, 3"}, 2, "out", kRolesCommands},
       {"scene_wrong_type", [](D d) { return with_scene(d, "/load/pressure_mmhg", "12"); },
        {"scene.json: ", "load.pressure_mmhg = \"12\" has the wrong type"}},
       {"scene_wrong_unit",
@@ -165,18 +172,20 @@ std::vector<Row> rows() {
       {"scene_missing", [](D d) { return d.file("no_scene.json"); }, {"no_scene.json: "}},
       {"ct_missing", [](D d) { return with_scene(d, "/inputs/ct", "nowhere.nii.gz"); },
        {"nowhere.nii.gz: ", "cannot open: No such file"}},
+      {"cavity_label_taken", [](D d) { return with_scene(d, "/output/cavity_label", 2); },
+       {"labels.nii.gz: ", "already uses label 2", "output.cavity_label"}, 2, "out", {"run", "warp"}},
       {"out_under_a_file",
        [](D d) {
          write_bytes(d.file("blocker"), "a file, not a folder");
          return write_tiny_case(d);
        },
-       {"blocker", "is not a folder"}, 2, "blocker/out"},
+       {"blocker", "is not a folder"}, 2, "blocker/out", kFolderCommands},
       {"out_is_a_file",
        [](D d) {
          write_bytes(d.file("taken"), "a file, not a folder");
          return write_tiny_case(d);
        },
-       {"taken: ", "not a folder"}, 2, "taken"},
+       {"taken: ", "not a folder"}, 2, "taken", kFolderCommands},
       {"no_cavity",
        [](D d) {
          json s = tiny_case_scene_json();
@@ -184,9 +193,9 @@ std::vector<Row> rows() {
          s["roles"]["other_labels"] = {2};
          return write_tiny_case(d, s);
        },
-       {"no cavity triangles", "roles."}},
+       {"no cavity triangles", "roles."}, 2, "out", kMeshCommands},
       {"everything_fixed", [](D d) { return with_scene(d, "/mesh/cube_voxels", 8); },
-       {"nodes is fixed", "nothing can move", "mesh.cube_voxels"}},
+       {"nodes is fixed", "nothing can move", "mesh.cube_voxels"}, 2, "out", kMeshCommands},
       {"wall_not_anchored",
        [](D d) {
          // The rim around the wall and the upper viscera becomes "other": the wall touches nothing fixed.
@@ -200,48 +209,135 @@ std::vector<Row> rows() {
          s["roles"]["other_labels"] = {4};
          return write_tiny_case(d, s, tiny_case_ct(), l);
        },
-       {"wall part", "attached to no fixed node", "drift", "roles.fixed_labels"}},
+       {"wall part", "attached to no fixed node", "drift", "roles.fixed_labels"}, 2, "out", kMeshCommands},
       {"time_step_beyond_the_limit",
        [](D d) {
          json s = tiny_case_scene_json();
          s["solver"] = {{"method", "explicit"}, {"dt_ms", 5.0}};
          return write_tiny_case(d, s);
        },
-       {"explicit diverged", "solver.dt_ms", "largest stable step"}, 1},
+       {"explicit diverged", "solver.dt_ms", "largest stable step"}, 1, "out", kMeshCommands},
   };
 }
 
-void PrintTo(const Row& row, std::ostream* os) { *os << row.name; }
+/// The error line with the case's folder left out: scratch folders are named after the test, and a
+/// row's name must not supply the words its message is checked for.
+std::string said(const CliResult& r, const ScratchDir& d) {
+  std::string err = r.err;
+  const std::string dir = d.path().string();
+  for (std::size_t at; (at = err.find(dir)) != std::string::npos;) err.replace(at, dir.size(), "DIR");
+  return err;
+}
 
-class HostileInput : public ::testing::TestWithParam<Row> {};
+/// One row through one command.
+struct Case {
+  Row row;
+  std::string command;
+};
+
+std::vector<Case> cases() {
+  std::vector<Case> out;
+  for (const Row& row : rows())
+    for (const std::string& command : row.commands) out.push_back({row, command});
+  return out;
+}
+
+Row row_named(const std::string& name) {
+  for (const Row& row : rows())
+    if (row.name == name) return row;
+  throw std::logic_error("no row " + name);
+}
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.command << " " << c.row.name; }
+
+/// `pneumo -q COMMAND SCENE --out DIR`.
+CliResult run_command(const std::string& command, const std::string& scene, const std::string& out) {
+  return run_pneumo("-q " + command + " " + scene + " --out " + out);
+}
+
+class HostileInput : public ::testing::TestWithParam<Case> {};
 
 TEST_P(HostileInput, OneLineExitCodeAndNothingWritten) {
-  const Row& row = GetParam();
+  const Row& row = GetParam().row;
+  const std::string& command = GetParam().command;
   ScratchDir d;
+  if (command == "warp") {   // a warp needs the simulation of the case it warps
+    const CliResult sim = run_command("simulate", write_tiny_case(d), d.file(row.out));
+    ASSERT_EQ(sim.code, 0) << sim.err;
+  }
   const std::string scene = row.make(d);
   const std::set<std::string> before = tree(d.path());
-  const CliResult r = run_pneumo("-q simulate " + scene + " --out " + d.file(row.out));
+  const CliResult r = run_command(command, scene, d.file(row.out));
   EXPECT_EQ(r.code, row.code) << r.err;
   ASSERT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  for (const std::string& words : row.expected) EXPECT_NE(r.err.find(words), std::string::npos) << r.err;
+  for (const std::string& words : row.expected) EXPECT_NE(said(r, d).find(words), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
   EXPECT_EQ(tree(d.path()), before) << "something was written";
 }
 
-INSTANTIATE_TEST_SUITE_P(Table, HostileInput, ::testing::ValuesIn(rows()),
-                         [](const ::testing::TestParamInfo<Row>& info) { return info.param.name; });
+INSTANTIATE_TEST_SUITE_P(Table, HostileInput, ::testing::ValuesIn(cases()),
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                           return info.param.command + "_" + info.param.row.name;
+                         });
 
 TEST(HostileInputControl, TheUnspoiledTinyCaseSimulates) {
   // Compared: the same command on the unspoiled case: exit 0 and metrics.json written, converged, the
   // wall lifted. Without this row the table above could pass on a case that never worked.
   ScratchDir d;
   const std::string scene = write_tiny_case(d);
-  const CliResult r = run_pneumo("-q simulate " + scene + " --out " + d.file("out"));
+  const CliResult r = run_command("simulate", scene, d.file("out"));
   ASSERT_EQ(r.code, 0) << r.err;
   const json m = json::parse(slurp(d.file("out/metrics.json")));
   EXPECT_TRUE(m["converged"].get<bool>());
   EXPECT_GT(m["max_wall_displacement_mm"].get<double>(), 0.1);
   EXPECT_EQ(m["inverted_tetrahedra"], 0);
+}
+
+TEST(HostileInputControl, TheUnspoiledTinyCaseWarpsRendersAndRuns) {
+  // Compared: the table's other commands on the unspoiled case: each exits 0 and writes what marks it
+  // done (warp: deformed_ct.nii.gz; render: render.json; run: report.html and a complete metrics.json).
+  ScratchDir d;
+  const std::string scene = write_tiny_case(d);
+  ASSERT_EQ(run_command("simulate", scene, d.file("sim")).code, 0);
+  const CliResult warp = run_command("warp", scene, d.file("sim"));
+  ASSERT_EQ(warp.code, 0) << warp.err;
+  EXPECT_TRUE(std::filesystem::exists(d.file("sim/deformed_ct.nii.gz")));
+  const CliResult render = run_command("render", scene, d.file("render"));
+  ASSERT_EQ(render.code, 0) << render.err;
+  EXPECT_TRUE(std::filesystem::exists(d.file("render/render.json")));
+  const CliResult run = run_command("run", scene, d.file("run"));
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_TRUE(std::filesystem::exists(d.file("run/report.html")));
+  EXPECT_TRUE(json::parse(slurp(d.file("run/metrics.json")))["pipeline_complete"].get<bool>());
+}
+
+/// Every file under `root` and its bytes.
+std::map<std::string, std::string> contents(const std::filesystem::path& root) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(root))
+    if (e.is_regular_file()) out[std::filesystem::relative(e.path(), root).string()] = read_bytes(e.path().string());
+  return out;
+}
+
+TEST(HostileInputRun, AForcedRunOnSpoiledInputLeavesTheEarlierResultsByteForByte) {
+  // Compared: the folder of a finished run, file by file and byte by byte, before and after
+  // `pneumo run --force` into it with one input spoiled at a time (the CT truncated, the labels off
+  // the CT's grid, a scene value out of range: exit 2; a time step beyond the stable limit: exit 1,
+  // the solve diverges). --force asks to replace the results, not to lose them to a run that fails.
+  ScratchDir d;
+  const std::string scene = write_tiny_case(d);
+  ASSERT_EQ(run_command("run", scene, d.file("out")).code, 0);
+  const std::map<std::string, std::string> earlier = contents(d.path() / "out");
+  ASSERT_TRUE(earlier.count("report.html"));
+  for (const char* spoil :
+       {"ct_truncated_nifti_gz", "labels_on_another_grid", "scene_out_of_range", "time_step_beyond_the_limit"}) {
+    SCOPED_TRACE(spoil);
+    const Row row = row_named(spoil);
+    const CliResult r = run_pneumo("-q run " + row.make(d) + " --out " + d.file("out") + " --force");
+    EXPECT_EQ(r.code, row.code) << r.err;
+    for (const std::string& words : row.expected) EXPECT_NE(said(r, d).find(words), std::string::npos) << r.err;
+    EXPECT_TRUE(contents(d.path() / "out") == earlier) << "the earlier run's results changed";
+  }
 }
 
 }  // namespace

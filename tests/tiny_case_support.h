@@ -61,7 +61,8 @@ inline nlohmann::json tiny_case_scene_json() {
       {"roles",
        {{"source", "labels"}, {"wall_labels", {1}}, {"viscera_labels", {2}}, {"fixed_labels", {3}}}},
       {"mesh", {{"cube_voxels", 2}}},
-      {"load", {{"pressure_mmhg", 12}}}};
+      {"load", {{"pressure_mmhg", 12}}},
+      {"render", {{"width", 32}, {"height", 24}}}};   // the exterior views only, small: `pneumo run` in seconds
 }
 
 /// Writes ct.nii.gz, labels.nii.gz and scene.json (from `scene`) into `dir`; returns the scene's path.

@@ -3,7 +3,6 @@
 
 #include "cli/commands.h"
 #include "core/atomic_file.h"
-#include "core/error.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/warp_stage.h"
 
@@ -26,10 +25,8 @@ Run add_render(CLI::App& app) {
     opt.out_dir = o->out;
     opt.backend = parse_gl_backend(o->backend);
     opt.cpu_reference = o->cpu;
-    std::error_code ec;
-    std::filesystem::create_directories(o->out, ec);
-    if (ec) throw InputError(o->out + ": cannot create the output folder (" + ec.message() + ")");
-    check_writable_target((std::filesystem::path(o->out) / "render.json").string());
+    // Checked now, created by the render only once the volumes are read and every pose is valid.
+    check_creatable_folder(o->out);
     // After simulate and warp into the same folder, ports travel with the skin through the solved shape.
     std::unique_ptr<DeformedMesh> deformed;
     std::unique_ptr<PointMap> point_map;

@@ -37,10 +37,12 @@ Run add_run(CLI::App& app) {
     ro.backend = parse_gl_backend(o->backend);
     const RunSummary s = run_pipeline(scene, ro);
     const auto& m = s.metrics;
-    std::printf("run: %s (%s), anterior rise %.1f mm, cavity %.0f ml, %d views, %.1f s in all; report %s\n",
+    std::printf("run: %s (%s), anterior rise %.1f mm, cavity %.0f ml, %lld inverted tetrahedra, %d views, %.1f s in "
+                "all; report %s\n",
                 m.value("stop_reason", "").c_str(), s.converged ? "converged" : "NOT converged",
                 m.value("anterior_rise_mm", 0.0), m.value("cavity_volume_ml", 0.0),
-                m["render"].value("views", 0), m["stage_seconds"].value("total", 0.0), s.report_path.c_str());
+                (long long)m.value("inverted_tetrahedra", int64_t(0)), m["render"].value("views", 0),
+                m["stage_seconds"].value("total", 0.0), s.report_path.c_str());
     return s.converged ? 0 : 1;
   };
 }

@@ -38,6 +38,8 @@ Run add_warp(CLI::App& app) {
     if (!o->force && (std::filesystem::exists(std::filesystem::path(o->out) / "deformed_ct.nii.gz") ||
                       warp_metrics_present(metrics_path)))
       throw InputError(o->out + ": already holds a warp; use --force to overwrite");
+    // A read-only folder is refused before the warp's work (write_warp checks again before writing).
+    if (std::filesystem::exists(metrics_path)) check_writable_target(metrics_path);
     const WarpedCase w = warp_scene(scene, o->out);
     write_warp(scene, w, o->out);
     std::printf("warp on %s: %lld voxels carried, %lld gas, %lld unchanged; cavity %.0f ml (%lld voxels) in %.2f s; "

@@ -16,6 +16,7 @@
 #include "render/image_out.h"
 #include "render/ray_cast_gl.h"
 #include "render/ray_cast_ref.h"
+#include "roles/label_map.h"
 
 namespace pneumo {
 namespace fs = std::filesystem;
@@ -126,7 +127,11 @@ RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
   log::info("render: " + run.ct_path + (run.labels_path.empty() ? "" : " with labels " + run.labels_path));
   const Volume ct = read_volume(run.ct_path);
   std::unique_ptr<Volume> labels;
-  if (!run.labels_path.empty()) labels = std::make_unique<Volume>(read_volume(run.labels_path));
+  if (!run.labels_path.empty()) {
+    labels = std::make_unique<Volume>(read_volume(run.labels_path));
+    check_labels_on_ct_grid(ct.geometry(), labels->geometry(), run.ct_path, run.labels_path);
+    check_label_values(*labels, run.labels_path);
+  }
   return render_volumes(scene, opt, ct, labels.get(), run);
 }
 
@@ -184,8 +189,8 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Vol
   for (const Path& p : paths) total += int64_t(p.cameras.size());
   if (total == 0) throw InputError("the scene's render section has no cameras, ports, paths or exterior views");
 
-  fs::create_directories(out / "views");
   Renderer renderer(opt);
+  fs::create_directories(out / "views");
   renderer.set_volume(volume);
   nlohmann::json view_report = nlohmann::json::array();
   Progress progress("render", total);

@@ -37,7 +37,9 @@ const char* const kRunFiles[] = {"report.html",       "metrics.json",           
                                  "pressure_volume.svg", "scene_used.json",      "roles.png"};
 const char* const kRunFolders[] = {"views", "flythrough", "timelapse"};
 
-void prepare_folder(const RunOptions& o) {
+/// The refusals that need no writing, before the inputs are read: an earlier run's results without
+/// --force (or --resume), an --out that could not be created or written.
+void check_output_folder(const RunOptions& o) {
   const fs::path out(o.out_dir);
   bool earlier = false;
   for (const char* f : kRunFiles) earlier |= fs::exists(out / f);
@@ -45,6 +47,13 @@ void prepare_folder(const RunOptions& o) {
   if (earlier && !o.force && !o.resume)
     throw InputError(o.out_dir + ": already holds results of a run; use --force to replace them or --resume to "
                                  "continue an interrupted one");
+  check_creatable_folder(o.out_dir);
+}
+
+/// Creates --out and removes an earlier run's files: only once the inputs have been read and checked,
+/// so that bad input leaves an earlier run's results as they were.
+void prepare_folder(const RunOptions& o) {
+  const fs::path out(o.out_dir);
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec) throw InputError(o.out_dir + ": cannot create the output folder (" + ec.message() + ")");
@@ -66,13 +75,14 @@ nlohmann::json read_json(const std::string& path) {
 
 RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   const auto t_run = std::chrono::steady_clock::now();
-  prepare_folder(o);
+  check_output_folder(o);
   const fs::path out(o.out_dir);
   const std::string checkpoint = (out / "checkpoint.bin").string();
 
   // Simulate: roles, mesh, solver (from the checkpoint with --resume).
   log::info("stage 1/4: roles, mesh and solver");
   Simulation sim = prepare_simulation(scene);
+  check_cavity_label_free(scene, sim.roles);
   SolveHooks hooks;
   if (o.resume && fs::exists(checkpoint)) {
     const Deformation c = read_deformation(checkpoint, sim.mesh);
@@ -106,8 +116,13 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
       }
     };
   }
-  write_roles_png(sim.roles, (out / "roles.png").string());
+  // The folder is touched at the first write: before the solve when it writes checkpoints or preview
+  // frames, else after it, so that a solve that diverges or stops leaves an earlier run as it was.
+  const bool writes_while_solving = hooks.on_snapshot != nullptr;
+  if (writes_while_solving) prepare_folder(o);
   solve_simulation(scene, sim, hooks);
+  if (!writes_while_solving) prepare_folder(o);
+  write_roles_png(sim.roles, (out / "roles.png").string());
   if (timelapse) {
     timelapse->frame(SolverSnapshot{sim.result.steps, 0.0, sim.result.final_pressure_pa, sim.result.x});
     log::info("inflation preview: " + std::to_string(timelapse->finish()) + " frames in " +

@@ -3,8 +3,11 @@
 // one folder. Each stage is the one its own subcommand runs (simulate, warp, render), so a run's
 // files are the same files; the run adds landmarks, plots, per-stage timings and report.html.
 //
-// Nothing lost: an existing output folder is refused without --force (or --resume); every file is
-// written atomically; report.html is written last, so a folder without it is not a finished run.
+// Nothing lost: an existing output folder is refused without --force (or --resume); the inputs are
+// read and checked before the folder is touched, and an earlier run's files are removed only at the
+// first write (after the solve, unless checkpoints or the preview write during it), so bad input or a
+// solve that diverges or stops leaves them as they were; every file is written atomically;
+// report.html is written last, so a folder without it is not a finished run.
 // With solver.checkpoint_every_steps the solver's positions go to checkpoint.bin as it runs, and
 // --resume continues from there: the static solver relaxes on from the saved shape and pressure;
 // a dynamic solver restarts from rest velocities at the saved shape, which changes the path it

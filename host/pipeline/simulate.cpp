@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <sstream>
 
@@ -22,6 +23,18 @@ namespace pneumo {
 namespace {
 /// Anterior in world RAS is +y.
 const Vec3 kAnterior(0.0, 1.0, 0.0);
+
+void throw_if_stopped_inverted(const SolveResult& r, const Mesh& m, double target_mmhg) {
+  if (r.stop_reason != "inverted tetrahedra") return;
+  char at[96];
+  std::snprintf(at, sizeof at, "at step %lld (%.1f of %.1f mmHg)", (long long)r.steps,
+                r.final_pressure_pa / units::kPaPerMmHg, target_mmhg);
+  throw InvertedStopError(r.solver + " stopped " + at + ": " + std::to_string(r.inverted_tetrahedra) + " of " +
+                          std::to_string(m.tets.size()) +
+                          " tetrahedra turned inside out and solver.on_inverted is \"stop\"; lower "
+                          "load.pressure_mmhg or raise material.young_kpa, or set solver.on_inverted to "
+                          "\"continue\" to finish the run and count them");
+}
 }  // namespace
 
 Simulation prepare_simulation(const Scene& scene) {
@@ -74,6 +87,7 @@ void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hoo
     SolveOptions opt = base;
     opt.start_pressure_pa = hooks.start_pressure_pa;
     sim.result = run(opt, hooks.x_start);
+    throw_if_stopped_inverted(sim.result, sim.mesh, scene.load.pressure_mmhg);
   } else {
     std::vector<double> pressures = scene.load.pressure_curve_mmhg;
     pressures.push_back(scene.load.pressure_mmhg);
@@ -92,6 +106,7 @@ void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hoo
         point.converged = true;
       } else {
         SolveResult r = run(opt, x);
+        throw_if_stopped_inverted(r, sim.mesh, p_mmhg);
         x = r.x;
         point.converged = r.converged;
         point.steps = r.steps;

@@ -1,6 +1,7 @@
 #pragma once
 // roles → mesh → solve for one scene: what `pneumo simulate` runs, and what the pipeline reuses.
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 
 #include "mesh/mesh.h"
@@ -42,9 +43,18 @@ struct SolveHooks {
   std::function<void(const SolverSnapshot&)> on_snapshot;
 };
 
-/// The scene's solver on its device, into sim.result. With load.pressure_curve_mmhg, every listed
-/// pressure and load.pressure_mmhg are solved in increasing order, each from the previous
-/// equilibrium (the start state then applies to none: a curve starts from rest).
+/// A solve that solver.on_inverted = "stop" ended at the first inverted tetrahedra: short of an
+/// equilibrium, so its shape is no result and nothing is written for it. The message counts them and
+/// says what to change.
+class InvertedStopError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The scene's solver on its device, into sim.result; InvertedStopError when it stopped for
+/// inversion. With load.pressure_curve_mmhg, every listed pressure and load.pressure_mmhg are solved
+/// in increasing order, each from the previous equilibrium (the start state then applies to none: a
+/// curve starts from rest).
 void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hooks = {});
 
 /// Plausibility measures of a solved mesh (method.md §9): displacements of the wall, the largest

@@ -72,6 +72,15 @@ DeformedMesh load_deformed_mesh(const Scene& scene, const std::string& sim_dir) 
   return d;
 }
 
+void check_cavity_label_free(const Scene& scene, const RoleVolume& roles) {
+  if (scene.inputs.labels.empty()) return;
+  const uint16_t cavity = uint16_t(scene.output.cavity_label);
+  for (uint16_t l : roles.label)
+    if (l == cavity)
+      throw file_error(scene.inputs.labels, "already uses label " + std::to_string(cavity) +
+                                                ", the cavity's id; choose a free one with output.cavity_label");
+}
+
 WarpedCase warp_scene(const Scene& scene, const std::string& sim_dir) {
   read_metrics(sim_dir);   // a finished simulation, before reading a large CT for nothing
   Volume ct = read_volume(scene.require_ct());
@@ -98,12 +107,8 @@ WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labe
   w.roles = std::move(roles);
   w.mesh = std::move(mesh);
   w.deformation = std::move(deformation);
+  if (w.labels) check_cavity_label_free(scene, w.roles);
   const uint16_t cavity = uint16_t(scene.output.cavity_label);
-  if (w.labels)
-    for (uint16_t l : w.roles.label)
-      if (l == cavity)
-        throw file_error(scene.inputs.labels, "already uses label " + std::to_string(cavity) +
-                                                  ", the cavity's id; choose a free one with output.cavity_label");
   w.warp_mesh = make_warp_mesh(w.mesh, w.deformation.displacement_m);
 
   WarpSource src;

@@ -49,6 +49,10 @@ struct DeformedMesh {
 };
 DeformedMesh load_deformed_mesh(const Scene& scene, const std::string& sim_dir);
 
+/// InputError naming the label map when it already uses output.cavity_label (the warp marks the
+/// cavity with it); `roles` were assigned from the scene's labels.
+void check_cavity_label_free(const Scene& scene, const RoleVolume& roles);
+
 /// Everything but the writing. `sim_dir` holds a finished simulation of this scene (metrics.json
 /// and deformation.bin); InputError naming the file otherwise, or when the label map already uses
 /// output.cavity_label.

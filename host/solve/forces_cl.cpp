@@ -78,7 +78,37 @@ void fill_block_table(const Csr& c, const std::vector<int>& blocks, const std::v
       }
 }
 
+struct DeviceBytes {
+  uint64_t total = 0, largest = 0;
+};
+
+/// Everything the evaluator allocates, before any of it is: node state (u, v, x₀, F: float4; mass;
+/// the block's nodes), the block tables (per record and lane: spring end, k, c, rest x/y/z/length: 28
+/// bytes; triangle or tetrahedron index: 4 bytes; and where each block's records begin), triangles
+/// and tetrahedra and their forces (with the zero entry past the last). The records are bounded by
+/// the widest block's: at most max degree per node.
+DeviceBytes evaluator_bytes(const Adjacency& adj, const std::vector<int>& blocks, int64_t nodes, int64_t tris,
+                            int64_t tets, uint64_t extra_bytes_per_node) {
+  const uint64_t N = uint64_t(blocks.size()), T = uint64_t(tets), R = uint64_t(tris);
+  const uint64_t block_begins = 3 * (N / kBlock + 1) * 4;
+  const uint64_t spring_entries = uint64_t(max_degree(adj.springs, nodes)) * N;
+  DeviceBytes b;
+  b.total = N * (4 * 16 + 4 + 4 + extra_bytes_per_node) + block_begins + spring_entries * 28 + (R + 1) * 32 +
+            uint64_t(max_degree(adj.tris, nodes)) * N * 4 + (T + 1) * (16 + 64) +
+            uint64_t(max_degree(adj.tets, nodes)) * N * 4;
+  b.largest = std::max({spring_entries * 4, (T + 1) * 64, N * 16});
+  return b;
+}
+
 }  // namespace
+
+uint64_t ClForceEvaluator::device_bytes(const Mesh& m, uint64_t extra_bytes_per_node) {
+  const Adjacency adj = Adjacency::of(m);
+  int64_t free_blocks = 0;
+  return evaluator_bytes(adj, block_nodes(m, adj, free_blocks), m.node_count(), int64_t(m.cavity_tris.size()),
+                         int64_t(m.tets.size()), extra_bytes_per_node)
+      .total;
+}
 
 std::vector<cl_float4> to_float4(const std::vector<Vec3>& v) {
   std::vector<cl_float4> out(v.size());
@@ -91,19 +121,8 @@ ClForceEvaluator::ClForceEvaluator(ocl::Context& ctx, const Mesh& m, uint64_t ex
   const Adjacency adj = Adjacency::of(m);
   const std::vector<int> blocks = block_nodes(m, adj, free_blocks_);
   blocks_ = int64_t(blocks.size()) / kBlock;
-  {
-    // Everything below, before any of it is allocated: node state (u, v, x₀, F: float4; mass), the
-    // block tables (the block's nodes; per record and lane: spring end, k, c, rest x/y/z/length:
-    // 28 bytes; triangle or tetrahedron index: 4 bytes), triangles and tetrahedra and their forces.
-    // The records are bounded by the widest block's: at most max degree per node.
-    const uint64_t N = uint64_t(blocks.size()), T = uint64_t(tets_), R = uint64_t(tris_);
-    const uint64_t spring_entries = uint64_t(max_degree(adj.springs, nodes_)) * N;
-    const uint64_t total = N * (4 * 16 + 4 + 4 + extra_bytes_per_node) + spring_entries * 28 + R * 32 +
-                           uint64_t(max_degree(adj.tris, nodes_)) * N * 4 + T * (16 + 64) +
-                           uint64_t(max_degree(adj.tets, nodes_)) * N * 4;
-    const uint64_t largest = std::max({spring_entries * 4, T * 64, N * 16});
-    ctx.check_fits(total, largest, "this mesh (" + std::to_string(nodes_) + " nodes)");
-  }
+  const DeviceBytes needs = evaluator_bytes(adj, blocks, nodes_, tris_, tets_, extra_bytes_per_node);
+  ctx.check_fits(needs.total, needs.largest, "this mesh (" + std::to_string(nodes_) + " nodes)");
 
   // Springs seen from each node: the other end, the spring's constants, the rest vector from the
   // other end to this node (in double, then rounded) and the length of that rounded vector.

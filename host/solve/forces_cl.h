@@ -17,6 +17,8 @@ class ClForceEvaluator {
   /// Uploads the mesh. Checks the memory it needs, plus `extra_bytes_per_node` the caller will
   /// allocate beside it, against the device first (InputError with the estimate if it does not fit).
   ClForceEvaluator(ocl::Context& ctx, const Mesh& mesh, uint64_t extra_bytes_per_node = 0);
+  /// That estimate (bytes): at least what the constructor allocates, plus the extra per node.
+  static uint64_t device_bytes(const Mesh& mesh, uint64_t extra_bytes_per_node = 0);
 
   /// Positions x (metres) go up as displacements x − x₀, formed in double.
   void upload_state(const std::vector<Vec3>& x, const std::vector<Vec3>& v);

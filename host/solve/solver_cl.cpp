@@ -34,9 +34,10 @@ struct Device {
     partial = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, groups * sizeof(cl_float4));
     k_monitor = kernel("monitor");
   }
-  // Beyond the force evaluator, per node: 1/m, the hold mask, and Newmark's five state vectors at
-  // most. The evaluator checks the total against the device before allocating anything.
-  static constexpr uint64_t kSolverBytesPerNode = 4 + 16 + 5 * 16;
+  // Beyond the force evaluator, per node: 1/m, the hold mask, Newmark's five state vectors at most,
+  // and a byte for the reduction's partial sums (16 bytes per group of kLocal nodes). The evaluator
+  // checks the total against the device before allocating anything.
+  static constexpr uint64_t kSolverBytesPerNode = 4 + 16 + 5 * 16 + 1;
   /// Checks the device's features (the reductions need work-groups and local memory).
   static ocl::Context& with_features(ocl::Context& ctx) {
     ocl::require_features(ctx.info(), kLocal, kLocal * sizeof(cl_float4));
@@ -307,6 +308,8 @@ SolveResult static_fire_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions&
 }
 
 }  // namespace
+
+uint64_t solver_device_bytes(const Mesh& m) { return ClForceEvaluator::device_bytes(m, Device::kSolverBytesPerNode); }
 
 SolveResult solve_opencl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x_start) {
   const std::vector<Vec3>& x0 = x_start.empty() ? m.rest_m : x_start;

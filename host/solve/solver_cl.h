@@ -5,6 +5,7 @@
 // monitor_every steps (FIRE: every step, three numbers). The 2004 scheme updates all nodes at once
 // (Jacobi) on the device, where the CPU reference goes node by node (Gauss–Seidel), as method.md §6
 // says; both stop at the same tolerance, so they reach the same equilibrium.
+#include <cstdint>
 #include <vector>
 
 #include "cl/cl_runtime.h"
@@ -15,6 +16,10 @@ namespace pneumo {
 /// Same contract as solve(): same options, same result fields, same DivergedError messages.
 SolveResult solve_opencl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt,
                          const std::vector<Vec3>& x_start = {});
+
+/// The device memory a solve of `m` is checked against before it allocates anything (bytes): at
+/// least what any of the four solvers allocates.
+uint64_t solver_device_bytes(const Mesh& m);
 
 /// For benchmarks: explicit steps with everything on the device and nothing read back.
 class ClExplicitStepper {

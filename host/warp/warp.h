@@ -64,9 +64,13 @@ struct WarpResult {
 /// The CPU reference. Deterministic for any thread count. Shows Progress("warp").
 WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt);
 
-/// kernels/warp.cl on a device, float32. Checks the device's memory first (ctx.check_fits).
+/// kernels/warp.cl on a device, float32. Checks the device's memory first (ctx.check_fits with
+/// warp_device_bytes).
 WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,
                        const WarpOptions& opt);
+
+/// The device memory warp_opencl needs (bytes): what it allocates, every buffer counted.
+uint64_t warp_device_bytes(const WarpMesh& mesh, bool has_labels, const WarpBox& box);
 
 /// warp_ref for "cpu", warp_opencl for "opencl" / "opencl:P:D" (InputError for anything else).
 WarpResult warp_on_device(const std::string& device, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,

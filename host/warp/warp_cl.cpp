@@ -74,6 +74,19 @@ cl::Buffer upload_async(ocl::Context& ctx, const T* data, std::size_t count) {
 
 }  // namespace
 
+uint64_t warp_device_bytes(const WarpMesh& mesh, bool has_labels, const WarpBox& box) {
+  // Source CT, roles and labels; owner, CT, labels and outcome per output voxel (without labels, a
+  // one-entry stand-in for each label buffer); tetrahedra (a record and a bounding box, at least one);
+  // the rest-space lattice (a byte per cube, a cube index per grid index along each axis).
+  const uint64_t src_bytes = uint64_t(mesh.grid.voxel_count()) * (4 + 1 + (has_labels ? 2 : 0));
+  const uint64_t out_bytes = uint64_t(box.voxel_count()) * (4 + 4 + 1 + (has_labels ? 2 : 0));
+  const uint64_t no_labels_bytes = has_labels ? 0 : 2 * 2;
+  const uint64_t tet_bytes = uint64_t(std::max<int64_t>(mesh.tet_count(), 1)) * (8 * 16 + 2 * 16);
+  const Index3& d = mesh.grid.dims;
+  const uint64_t lattice_bytes = std::max<uint64_t>(mesh.cube_meshed.size(), 1) + uint64_t(d[0] + d[1] + d[2]) * 4;
+  return src_bytes + out_bytes + no_labels_bytes + tet_bytes + lattice_bytes;
+}
+
 WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,
                        const WarpOptions& opt) {
   check_warp_mesh(mesh);
@@ -83,11 +96,7 @@ WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource
   if (T >= INT_MAX / 8) throw InputError("the warp handles at most 2^28 tetrahedra");
   ocl::require_features(ctx.info(), kLocal, 0);
   const bool has_labels = src.labels != nullptr;
-  // Source CT, roles and labels; owner, CT, labels and outcome per output voxel; tetrahedra.
-  const uint64_t src_bytes = uint64_t(n_src) * (4 + 1 + (has_labels ? 2 : 0));
-  const uint64_t out_bytes = uint64_t(n_out) * (4 + 4 + 1 + (has_labels ? 2 : 0));
-  const uint64_t tet_bytes = uint64_t(T) * (8 * 16 + 2 * 16);
-  ctx.check_fits(src_bytes + out_bytes + tet_bytes,
+  ctx.check_fits(warp_device_bytes(mesh, has_labels, box),
                  std::max<uint64_t>(uint64_t(n_src) * 4, uint64_t(n_out) * 4), "the image warp");
 
   PhaseTimer timer("warp on " + ctx.info().spec());
