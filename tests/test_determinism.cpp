@@ -7,13 +7,17 @@
 // one documented exception: they measure the machine, not the result, and are compared with those keys
 // removed. Why it holds: every force is a per-node gather in a fixed order (no atomics, no reductions
 // whose order depends on the thread count or the schedule); the device reduces its work-groups' partial
-// results on the host in group order.
+// results on the host in group order; the warp's lowest accepting tetrahedron wins whatever the order.
+// Also: every solver on every device on the tiny case, and `pneumo run` (roles, mesh, solve, warp,
+// render, report) twice as separate processes, every file it writes byte for byte with the same
+// exception (the timings in metrics.json and render.json, and report.html, which prints them).
 #include <gtest/gtest.h>
 
 #include <omp.h>
 #include <filesystem>
 
 #include "cli_test_support.h"
+#include "tiny_case_support.h"
 #include "core/progress.h"
 #include "opencl_test_support.h"
 #include "phantom/phantom.h"
@@ -36,11 +40,17 @@ Scene phantom_scene(const ScratchDir& dir) {
   return scene;
 }
 
+/// metrics.json or render.json without the wall-clock timings: the documented exception (README).
 nlohmann::json without_timings(nlohmann::json m) {
   m.erase("wall_time_s");
   m.erase("stage_seconds");
+  m.erase("seconds");   // render.json
   if (m.contains("pressure_curve"))
     for (auto& p : m["pressure_curve"]) p.erase("wall_time_s");
+  if (m.contains("warp")) {
+    m["warp"].erase("seconds");
+    m["warp"].erase("mvoxels_per_s");
+  }
   return m;
 }
 
@@ -115,6 +125,97 @@ TEST_P(DeterminismPerDevice, OpenClRunsAreBitIdentical) {
 
 INSTANTIATE_TEST_SUITE_P(Devices, DeterminismPerDevice,
                          ::testing::ValuesIn(testing_support::opencl_device_specs()),
+                         [](const ::testing::TestParamInfo<std::string>& i) {
+                           return testing_support::spec_name(i.param);
+                         });
+
+
+/// Every solver on every device (the CPU reference and each OpenCL device): two runs of the tiny case in
+/// one process end on the same positions bit for bit, after the same number of steps.
+class DeterminismPerSolver : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
+
+TEST_P(DeterminismPerSolver, TwoRunsEndBitIdentical) {
+  const auto& [method, device] = GetParam();
+  ScratchDir dir;
+  nlohmann::json j = testing_support::tiny_case_scene_json();
+  j["solver"]["method"] = method;
+  j["device"] = device;
+  Progress::set_enabled(false);
+  const Scene scene = load_scene(testing_support::write_tiny_case(dir, j));
+  const Simulation a = simulate_scene(scene), b = simulate_scene(scene);
+  ASSERT_EQ(a.result.x.size(), b.result.x.size());
+  EXPECT_GT(a.result.steps, 0);
+  EXPECT_EQ(a.result.steps, b.result.steps);
+  int64_t differing = 0, moved = 0;
+  for (std::size_t n = 0; n < a.result.x.size(); ++n) {
+    differing += a.result.x[n] != b.result.x[n];
+    moved += a.result.x[n] != a.mesh.rest_m[n];
+  }
+  EXPECT_GT(moved, 0) << "nothing moved: the comparison would be empty";
+  EXPECT_EQ(differing, 0) << "nodes whose final position differs between two runs";
+}
+
+std::vector<std::string> every_device() {
+  std::vector<std::string> devices{"cpu"};
+  for (const std::string& d : testing_support::opencl_device_specs()) devices.push_back(d);
+  return devices;
+}
+
+std::vector<std::tuple<std::string, std::string>> solver_device_pairs() {
+  std::vector<std::tuple<std::string, std::string>> out;
+  for (const char* m : {"static", "explicit", "newmark", "kitasaka2004"})
+    for (const std::string& d : every_device()) out.emplace_back(m, d);
+  return out;
+}
+
+INSTANTIATE_TEST_SUITE_P(SolversAndDevices, DeterminismPerSolver, ::testing::ValuesIn(solver_device_pairs()),
+                         [](const ::testing::TestParamInfo<std::tuple<std::string, std::string>>& i) {
+                           return std::get<0>(i.param) + "_" + testing_support::spec_name(std::get<1>(i.param));
+                         });
+
+/// `pneumo run` twice, as two processes (the second finds PoCL's kernel cache warm), on each device:
+/// every file of the two folders byte for byte, metrics.json and render.json without their timings,
+/// report.html not compared (it prints the timings); the output folder's own path, which some files
+/// name, read as OUT in both.
+class DeterminismOfRun : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(DeterminismOfRun, TwoProcessesWriteTheSameFiles) {
+  ScratchDir dir;
+  nlohmann::json j = testing_support::tiny_case_scene_json();
+  j["device"] = GetParam();
+  const std::string scene = testing_support::write_tiny_case(dir, j);
+  for (const char* out : {"a", "b"}) {
+    const testing_support::CliResult r = testing_support::run_pneumo("-q run " + scene + " --out " + dir.file(out));
+    ASSERT_EQ(r.code, 0) << r.err;
+  }
+  const auto files = testing_support::tree(dir.file("a"));
+  EXPECT_EQ(files, testing_support::tree(dir.file("b")));
+  int compared = 0;
+  for (const std::string& name : files) {
+    const std::filesystem::path pa = dir.path() / "a" / name, pb = dir.path() / "b" / name;
+    if (std::filesystem::is_directory(pa) || name == "report.html") continue;
+    SCOPED_TRACE(name);
+    // Paths name the output folder (render.json's "ct": OUT/deformed_ct.nii.gz): the same in both once named alike.
+    auto read = [&](const std::filesystem::path& f, const char* out) {
+      std::string text = testing_support::slurp(f.string());
+      const std::string folder = dir.file(out);
+      for (std::size_t at; (at = text.find(folder)) != std::string::npos;) text.replace(at, folder.size(), "OUT");
+      return text;
+    };
+    const std::string fa = read(pa, "a"), fb = read(pb, "b");
+    ++compared;
+    if (name == "metrics.json" || name == "render.json") {
+      EXPECT_EQ(without_timings(nlohmann::json::parse(fa)), without_timings(nlohmann::json::parse(fb)));
+    } else {
+      EXPECT_TRUE(fa == fb) << "differs between runs";
+    }
+  }
+  for (const char* must : {"deformed_ct.nii.gz", "deformed_labels.nii.gz", "mesh_deformed.vtu", "metrics.json"})
+    EXPECT_TRUE(files.count(must)) << must;
+  EXPECT_GE(compared, 10);
+}
+
+INSTANTIATE_TEST_SUITE_P(Devices, DeterminismOfRun, ::testing::ValuesIn(every_device()),
                          [](const ::testing::TestParamInfo<std::string>& i) {
                            return testing_support::spec_name(i.param);
                          });

@@ -13,6 +13,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <exception>
+#include <memory>
+#include <thread>
 
 #include "core/progress.h"
 #include "warp/phase_timer.h"
@@ -28,16 +31,21 @@ namespace {
 // to whole cache lines; 8 planes match the usual cube size, so a tetrahedron spans about two.
 constexpr Index3 kTile{64, 32, 8};
 
-/// One deformed tetrahedron, ready for containment tests.
+/// One deformed tetrahedron, ready for containment tests. No default member values: the table of them
+/// (~300 bytes a tetrahedron) is allocated uninitialised and filled in parallel by prepare(), which
+/// sets every field, rather than zeroed first on one thread.
 struct RefTet {
-  bool skip = true;                // degenerate (warp_tet_degenerate)
-  Vec3 x0;                         // deformed vertex 0
-  Mat3 e_inv;                      // inverse of [x1−x0, x2−x0, x3−x0]
-  Vec3 d0;                         // displacement of vertex 0
-  Mat3 dd;                         // [d1−d0, d2−d0, d3−d0]
+  bool skip;                        // degenerate (warp_tet_degenerate), or its box misses the output
+  Vec3 x0;                          // deformed vertex 0
+  Mat3 e_inv;                       // inverse of [x1−x0, x2−x0, x3−x0]
+  Vec3 d0;                          // displacement of vertex 0
+  Mat3 dd;                          // [d1−d0, d2−d0, d3−d0]
   double w_step[4], w_step_inv[4];  // each weight's change per voxel along i, and its inverse (row spans)
-  Index3 lo{0, 0, 0}, hi{-1, -1, -1};   // voxel centres of the bounding box (box-clipped, inclusive)
-  Part part = Part::Wall;
+  Index3 lo, hi;                    // voxel centres of the bounding box (box-clipped, inclusive)
+  Part part;
+  // Every source point it maps lies inside the grid, a whole voxel clear of the far faces: its voxels
+  // sample without bounds checks or clamping (SourceGrid's *_interior).
+  bool interior;
 };
 
 /// A tile's voxel range, inclusive, in working-grid indices.
@@ -46,7 +54,8 @@ struct Tile {
 };
 
 RefTet prepare(const WarpMesh& m, int64_t t, const WarpBox& box) {
-  RefTet r;
+  RefTet r{};
+  r.skip = true;
   if (warp_tet_degenerate(m, t)) return r;
   const auto& v = m.tets[std::size_t(t)];
   Vec3 x[4];
@@ -70,6 +79,15 @@ RefTet prepare(const WarpMesh& m, int64_t t, const WarpBox& box) {
     r.lo[a] = std::max<int64_t>(box.lo[a], int64_t(std::ceil(lo - margin)));
     r.hi[a] = std::min<int64_t>(box.lo[a] + box.dims[a] - 1, int64_t(std::floor(hi + margin)));
     if (r.lo[a] > r.hi[a]) r.skip = true;
+  }
+  // Source points are the rest tetrahedron's points at weights ≥ −ε (plus rounding): within its box
+  // widened like the deformed one's.
+  r.interior = true;
+  for (int a = 0; a < 3; ++a) {
+    double lo = m.rest_ijk[v[0]][a], hi = lo;
+    for (int c = 1; c < 4; ++c) lo = std::min(lo, m.rest_ijk[v[c]][a]), hi = std::max(hi, m.rest_ijk[v[c]][a]);
+    const double margin = 4.0 * kWarpTolerance * (hi - lo) + 1e-6;
+    r.interior &= lo - margin >= 0.0 && hi + margin < double(m.grid.dims[a] - 1);
   }
   return r;
 }
@@ -101,13 +119,65 @@ const uint8_t* rest_row(const WarpMesh& m, int64_t j, int64_t k) {
   return m.cube_meshed.data() + m.cubes[0] * (b + m.cubes[1] * c);
 }
 
+/// The output the scatter writes, its outcome doubling as the scatter's state: Kept = inside no
+/// tetrahedron yet, Gas = inside one that refused its source, Carried = taken (and sampled) by the
+/// first, so lowest-indexed, accepting one.
+struct ScatterOutput {
+  WarpOutcome* outcome;
+  float* hu;
+  uint16_t* label;   // null: no label output
+};
+
+/// Voxels row + 0 … row + count of one row inside tetrahedron r, whose source points are
+/// source0 + t · step. Interior: r.interior holds, so no source point needs a bounds check.
+template <bool Interior>
+void scatter_row(const RefTet& r, const SourceGrid& grid, const Vec3& source0, const Vec3& step, int64_t count,
+                 std::size_t row, const ScatterOutput& out) {
+  for (int64_t t = 0; t <= count; ++t) {
+    const std::size_t n = row + std::size_t(t);
+    if (out.outcome[n] == WarpOutcome::Carried) continue;   // a lower index already took it
+    const Vec3 from = source0 + double(t) * step;
+    const int64_t v = Interior ? grid.nearest_interior(from) : grid.nearest(from);
+    const Role role = v < 0 ? Role::Other : grid.roles[v];
+    if (r.part == Part::Wall ? role == Role::Viscera : role == Role::Wall) {
+      out.outcome[n] = WarpOutcome::Gas;   // covered; gas unless a later tetrahedron accepts it
+      continue;
+    }
+    out.outcome[n] = WarpOutcome::Carried;
+    if (Interior) out.hu[n] = float(grid.ct_trilinear_interior(from));
+    else out.hu[n] = v < 0 ? float(SourceGrid::kOutsideHu) : float(grid.ct_trilinear_inside(from));
+    if (out.label) out.label[n] = v < 0 ? uint16_t(0) : grid.labels[v];
+  }
+}
+
 }  // namespace
 
 WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt) {
   check_warp_mesh(mesh);
   PhaseTimer timer("warp on cpu");
   const int64_t T = mesh.tet_count();
-  std::vector<RefTet> tets(static_cast<std::size_t>(T));
+  // The outputs' hundreds of MB are faulted in and zeroed by the kernel on a thread of their own
+  // while the tetrahedra are prepared: each waits on memory, not on the other.
+  WarpResult out;
+  out.device = "cpu";
+  const int64_t n_out = box.voxel_count();
+  std::exception_ptr allocate_failed;   // bad_alloc, rethrown here after the join
+  std::thread allocate([&] {
+    try {
+      out.ct_hu.resize(std::size_t(n_out));
+      if (src.labels) out.labels.resize(std::size_t(n_out));
+      out.outcome.resize(std::size_t(n_out), WarpOutcome::Kept);
+    } catch (...) {
+      allocate_failed = std::current_exception();
+    }
+  });
+  struct JoinOnExit {   // also when preparing throws: a joinable thread's destructor would terminate
+    std::thread& t;
+    ~JoinOnExit() {
+      if (t.joinable()) t.join();
+    }
+  } join_allocate{allocate};
+  const std::unique_ptr<RefTet[]> tets(new RefTet[std::size_t(T)]);
 #pragma omp parallel for schedule(static)
   for (int64_t t = 0; t < T; ++t) tets[std::size_t(t)] = prepare(mesh, t, box);
   timer.lap("tetrahedra");
@@ -127,13 +197,9 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
   }
 
   timer.lap("tiles");
+  allocate.join();
+  if (allocate_failed) std::rethrow_exception(allocate_failed);
   const SourceGrid grid{mesh.grid.dims, src.ct_hu, src.labels, src.roles};
-  WarpResult out;
-  out.device = "cpu";
-  const int64_t n_out = box.voxel_count();
-  out.ct_hu.resize(std::size_t(n_out));
-  if (src.labels) out.labels.resize(std::size_t(n_out));
-  out.outcome.resize(std::size_t(n_out), WarpOutcome::Kept);
 
   const int64_t nx = box.dims[0], ny = box.dims[1];
   // Cube column of each voxel column i (a table: an integer division per voxel costs more than the rest).
@@ -143,15 +209,14 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
   Progress progress("warp", n_tiles);
   std::atomic<int64_t> done{0};
   int64_t carried = 0, gas = 0, kept = 0;
-  // The output voxel of working-grid index (i, j, k); its outcome doubles as the scatter's state:
-  // Kept = inside no tetrahedron yet, Gas = inside one that refused its source, Carried = taken
-  // (and sampled) by the first, so lowest-indexed, accepting one.
+  // The output voxel of working-grid index (i, j, k).
   auto out_index = [&](int64_t i, int64_t j, int64_t k) {
     return std::size_t((i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - box.lo[2])));
   };
-  WarpOutcome* const outcome = out.outcome.data();
-  float* const hu = out.ct_hu.data();
-  uint16_t* const label = src.labels ? out.labels.data() : nullptr;
+  const ScatterOutput state{out.outcome.data(), out.ct_hu.data(), src.labels ? out.labels.data() : nullptr};
+  WarpOutcome* const outcome = state.outcome;
+  float* const hu = state.hu;
+  uint16_t* const label = state.label;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : carried, gas, kept)
   for (int64_t n_tile = 0; n_tile < n_tiles; ++n_tile) {
     Tile tile;
@@ -186,20 +251,8 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
           const double di = double(first - lo[0]);
           const Vec3 source0 = source_corner + di * source_along[0] + dj * source_along[1] + dk * source_along[2];
           const std::size_t row = out_index(first, j, k);
-          for (int64_t step = 0; step <= last - first; ++step) {
-            const std::size_t n = row + std::size_t(step);
-            if (outcome[n] == WarpOutcome::Carried) continue;   // a lower index already took it
-            const Vec3 from = source0 + double(step) * source_along[0];
-            const int64_t v = grid.nearest(from);
-            const Role role = v < 0 ? Role::Other : src.roles[v];
-            if (r.part == Part::Wall ? role == Role::Viscera : role == Role::Wall) {
-              outcome[n] = WarpOutcome::Gas;   // covered; gas unless a later tetrahedron accepts it
-              continue;
-            }
-            outcome[n] = WarpOutcome::Carried;
-            hu[n] = v < 0 ? float(SourceGrid::kOutsideHu) : float(grid.ct_trilinear_inside(from));
-            if (label) label[n] = v < 0 ? uint16_t(0) : src.labels[v];
-          }
+          if (r.interior) scatter_row<true>(r, grid, source0, source_along[0], last - first, row, state);
+          else scatter_row<false>(r, grid, source0, source_along[0], last - first, row, state);
         }
     }
     // 2. What no tetrahedron took: gas inside the meshes' space before or after deformation,

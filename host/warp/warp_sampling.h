@@ -48,6 +48,10 @@ struct SourceGrid {
     }
     return n[0] + dims[0] * (n[1] + dims[1] * n[2]);
   }
+  /// nearest() for a point known to lie inside ([0, n − 1) on each axis): no checks.
+  int64_t nearest_interior(const Vec3& p) const {
+    return int64_t(p[0] + 0.5) + dims[0] * (int64_t(p[1] + 0.5) + dims[1] * int64_t(p[2] + 0.5));
+  }
   Role role_nearest(const Vec3& p) const {
     const int64_t v = nearest(p);
     return v < 0 ? Role::Other : roles[v];
@@ -57,14 +61,20 @@ struct SourceGrid {
     return v < 0 || !labels ? uint16_t(0) : labels[v];
   }
   double ct_trilinear(const Vec3& p) const { return nearest(p) < 0 ? kOutsideHu : ct_trilinear_inside(p); }
+  /// ct_trilinear at a point in [0, n − 1) on each axis: truncation is the floor, and the stencil
+  /// needs no clamping.
+  double ct_trilinear_interior(const Vec3& p) const {
+    const int64_t i = int64_t(p[0]), j = int64_t(p[1]), k = int64_t(p[2]);
+    return trilinear(ct_hu + i + dims[0] * (j + dims[1] * k), 1, dims[0], dims[0] * dims[1], p[0] - double(i),
+                     p[1] - double(j), p[2] - double(k));
+  }
   /// ct_trilinear at a point known to be inside (nearest(p) ≥ 0): the warp has just looked.
   double ct_trilinear_inside(const Vec3& p) const {
     // Away from the grid's far faces and at or past its near ones (nearly every voxel the warp
     // samples), the stencil needs no clamping and truncation is the floor.
-    const int64_t i = int64_t(p[0]), j = int64_t(p[1]), k = int64_t(p[2]);
-    if (p[0] >= 0.0 && p[1] >= 0.0 && p[2] >= 0.0 && i < dims[0] - 1 && j < dims[1] - 1 && k < dims[2] - 1)
-      return trilinear(ct_hu + i + dims[0] * (j + dims[1] * k), 1, dims[0], dims[0] * dims[1],
-                       p[0] - double(i), p[1] - double(j), p[2] - double(k));
+    if (p[0] >= 0.0 && p[1] >= 0.0 && p[2] >= 0.0 && p[0] < double(dims[0] - 1) && p[1] < double(dims[1] - 1) &&
+        p[2] < double(dims[2] - 1))
+      return ct_trilinear_interior(p);
     // The stencil's corner and its step to the +1 neighbour on each axis: zero where the neighbour
     // is clamped to the edge voxel.
     int64_t corner[3], step[3];
