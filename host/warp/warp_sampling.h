@@ -10,6 +10,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "core/geometry.h"
 #include "scene/scene.h"
@@ -65,8 +68,27 @@ struct SourceGrid {
   /// needs no clamping.
   double ct_trilinear_interior(const Vec3& p) const {
     const int64_t i = int64_t(p[0]), j = int64_t(p[1]), k = int64_t(p[2]);
-    return trilinear(ct_hu + i + dims[0] * (j + dims[1] * k), 1, dims[0], dims[0] * dims[1], p[0] - double(i),
-                     p[1] - double(j), p[2] - double(k));
+    const float* c = ct_hu + i + dims[0] * (j + dims[1] * k);
+    const double fx = p[0] - double(i), fy = p[1] - double(j), fz = p[2] - double(k);
+#if defined(__SSE2__)
+    // The same products and sums as trilinear() below, two lanes at a time (so the same bits): the
+    // stencil's neighbours along i are adjacent floats, loaded and widened as pairs.
+    const int64_t y = dims[0], z = dims[0] * dims[1];
+    auto pair = [](const float* at) {   // (at[0], at[1]) as doubles
+      return _mm_cvtps_pd(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(at))));
+    };
+    const __m128d p00 = pair(c), p10 = pair(c + y), p01 = pair(c + z), p11 = pair(c + z + y);
+    const __m128d wx0 = _mm_set1_pd(1 - fx), wx1 = _mm_set1_pd(fx);
+    // x: (c00, c10) and (c01, c11)
+    const __m128d x0 = _mm_add_pd(_mm_mul_pd(_mm_unpacklo_pd(p00, p10), wx0), _mm_mul_pd(_mm_unpackhi_pd(p00, p10), wx1));
+    const __m128d x1 = _mm_add_pd(_mm_mul_pd(_mm_unpacklo_pd(p01, p11), wx0), _mm_mul_pd(_mm_unpackhi_pd(p01, p11), wx1));
+    // y: (c0, c1)
+    const __m128d yz = _mm_add_pd(_mm_mul_pd(_mm_unpacklo_pd(x0, x1), _mm_set1_pd(1 - fy)),
+                                  _mm_mul_pd(_mm_unpackhi_pd(x0, x1), _mm_set1_pd(fy)));
+    return _mm_cvtsd_f64(yz) * (1 - fz) + _mm_cvtsd_f64(_mm_unpackhi_pd(yz, yz)) * fz;
+#else
+    return trilinear(c, 1, dims[0], dims[0] * dims[1], fx, fy, fz);
+#endif
   }
   /// ct_trilinear at a point known to be inside (nearest(p) ≥ 0): the warp has just looked.
   double ct_trilinear_inside(const Vec3& p) const {
