@@ -27,8 +27,11 @@ rm -f "$work/vtk_tetwarp.jsonl"
   --log "$work/vtk_tetwarp.jsonl"
 cmake -S "$peers" -B "$work/itk-build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$work/itk-build" --target itk_warp >/dev/null
+# Each timed tool starts with the previous one's files on disk (sync), so none pays for another's writeback.
+sync
 echo "compare_warp: pneumo on the same mesh and lift" >&2
 build/pneumo bench --peer-warp "$work" --repeats 3 > "$work/pneumo_peer_warp.json"
+sync
 echo "compare_warp: ITK through VTK's field and through pneumo's" >&2
 "$work/itk-build/itk_warp" "$work/phantom.mhd" "$work/disp.mhd" --out "$work/warped_itk.mhd" --repeats 3 |
   tee "$work/itk_warp.txt"
