@@ -3,7 +3,9 @@
 //
 // Scatter without atomics: the output is cut into tiles small enough that a tile's output and the
 // source it reads stay in a core's L2 cache (a voxel's trilinear stencil and role lookup are
-// gathers: from L3 or DRAM they, not the arithmetic, set the speed). Each tetrahedron is listed,
+// gathers). Where tetrahedra are small the rows through them are short, and each row's set-up
+// (its span, its first source point) costs as much as its voxels: both are kept to a few
+// multiply-adds. Each tetrahedron is listed,
 // in index order, under every tile its bounding box touches. One thread owns a tile at a time and
 // visits its tetrahedra in ascending order, so "the lowest accepting index wins" is "the first
 // accepting one wins", whatever the thread count: the first one samples the CT and labels at its
@@ -28,8 +30,8 @@ namespace {
 
 // Output voxels per tile along i, j, k: 16 K voxels, whose outputs (7 B each) and source stencils
 // take a few hundred KiB of a 1–2 MiB L2. Long rows matter most: a tetrahedron cut by a tile's
-// i-face costs each of its rows twice, so 256 (measured against 64 and 128 on the peers' case:
-// 5–15 % faster); 8 planes match the usual cube size, so a tetrahedron spans about two.
+// i-face costs each of its rows twice, so 256 (on the peers' case a little faster than 64 or 128,
+// bench/results/2026-12-01-warp.md); 8 planes match the usual cube size, so a tetrahedron spans two.
 constexpr Index3 kTile{256, 8, 8};
 
 /// One deformed tetrahedron, ready for containment tests. No default member values: the table of them
