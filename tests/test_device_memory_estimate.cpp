@@ -7,6 +7,7 @@
 #include <dlfcn.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 
@@ -70,6 +71,7 @@ class DeviceMemoryEstimate : public ::testing::TestWithParam<std::string> {
 
 TEST_P(DeviceMemoryEstimate, EverySolverAllocatesNoMoreThanItsEstimate) {
   const uint64_t estimate = solver_device_bytes(sim_.mesh);
+  uint64_t most = 0;
   for (SolverMethod method :
        {SolverMethod::Static, SolverMethod::Explicit, SolverMethod::Newmark, SolverMethod::Kitasaka2004}) {
     SolveOptions o = solve_options_from_scene(scene_);
@@ -82,10 +84,14 @@ TEST_P(DeviceMemoryEstimate, EverySolverAllocatesNoMoreThanItsEstimate) {
                                    << estimate;
     std::printf("%s: %llu bytes allocated, %llu estimated\n", enum_name(method), (unsigned long long)allocated,
                 (unsigned long long)estimate);
+    most = std::max(most, allocated);
   }
+  // Not a refusal of cases that fit: the estimate bounds each block's spring records by the mesh's
+  // largest node degree, which overstates, but by less than twice what the hungriest solver allocates.
+  EXPECT_LT(estimate, 2 * most) << "the estimate would refuse meshes that fit";
 }
 
-TEST_P(DeviceMemoryEstimate, TheWarpAllocatesNoMoreThanItsEstimate) {
+TEST_P(DeviceMemoryEstimate, TheWarpAllocatesExactlyItsEstimate) {
   Volume ct = read_volume(scene_.require_ct());
   Volume labels = read_volume(scene_.inputs.labels);
   const Geometry grid = ct.geometry();
@@ -98,7 +104,7 @@ TEST_P(DeviceMemoryEstimate, TheWarpAllocatesNoMoreThanItsEstimate) {
   });
   const uint64_t estimate = warp_device_bytes(w->warp_mesh, true, WarpBox{w->roles.pad.lo, grid.dims});
   EXPECT_GT(allocated, 0u) << "the count saw no buffer";
-  EXPECT_LE(allocated, estimate) << "allocated " << allocated << " bytes, estimated " << estimate;
+  EXPECT_EQ(allocated, estimate) << "the warp's estimate counts every buffer it creates";
   std::printf("warp: %llu bytes allocated, %llu estimated\n", (unsigned long long)allocated,
               (unsigned long long)estimate);
 }

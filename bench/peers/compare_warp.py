@@ -45,33 +45,34 @@ def stats(a, b, mask):
                 n_gt_1=int((d > 1.0).sum()))
 
 
-def speeds(d, voxels):
+def last_record(path, prefix=None):
+    """The JSON in path: the whole file, or with prefix the last line starting with it (after it); None if absent."""
+    try:
+        with open(path) as f:
+            if prefix is None:
+                return json.load(f)
+            lines = [l[len(prefix):] for l in f if l.startswith(prefix)]
+        return json.loads(lines[-1]) if lines else None
+    except (OSError, ValueError):
+        return None
+
+
+def speeds(d):
     """Seconds of each whole job in this run, from the logs compare_warp.sh leaves (missing ones are left out)."""
     out = {}
-    try:
-        with open(os.path.join(d, "vtk_tetwarp.jsonl")) as f:
-            vtk = json.loads(f.read().strip().splitlines()[-1])
+    vtk = last_record(os.path.join(d, "vtk_tetwarp.jsonl"), "")
+    if vtk and "total_probe_plus_mapcoords_s" in vtk:
         out["vtk_pipeline"] = vtk["total_probe_plus_mapcoords_s"]
-        out["vtk_probe"] = vtk["probe_s"]
-    except (OSError, IndexError, KeyError, ValueError):
-        pass
-    try:
-        with open(os.path.join(d, "itk_warp.txt")) as f:
-            line = [l for l in f if l.startswith("RESULT ")][-1]
-        itk = json.loads(line[len("RESULT "):])
+        out["vtk_probe"] = vtk.get("probe_s")
+    itk = last_record(os.path.join(d, "itk_warp.txt"), "RESULT ")
+    if itk and "resample_s_median" in itk:
         out["itk_resample"] = itk["resample_s_median"]
-        out["itk_threads"] = itk["threads"]
-    except (OSError, IndexError, KeyError, ValueError):
-        pass
-    try:
-        with open(os.path.join(d, "pneumo_peer_warp.json")) as f:
-            pn = json.load(f)
-        for w in pn["warps"]:
-            key = "pneumo_cpu" if w["device"] == "cpu" else "pneumo_opencl"
-            out[key] = w["seconds"]
-            out[key + "_other_cores_max"] = w.get("other_cores_max")
-    except (OSError, KeyError, ValueError):
-        pass
+        out["itk_threads"] = itk.get("threads")
+    pn = last_record(os.path.join(d, "pneumo_peer_warp.json"))
+    for w in (pn or {}).get("warps", []):
+        key = "pneumo_cpu" if w["device"] == "cpu" else "pneumo_opencl"
+        out[key] = w["seconds"]
+        out[key + "_other_cores_max"] = w.get("other_cores_max")
     for dev in ("pneumo_cpu", "pneumo_opencl"):
         for peer in ("vtk_pipeline", "itk_resample"):
             if dev in out and peer in out:
@@ -153,7 +154,7 @@ def main():
         rec["field_mm_pneumo_vs_vtk"] = dict(voxels=int(both.sum()), max_abs=float(d[both].max()),
                                              mean_abs=float(d[both].mean()),
                                              max_abs_all_carried=float(d[carried].max()))
-    rec["speed"] = speeds(a.dir, int(src.size))
+    rec["speed"] = speeds(a.dir)
     text = json.dumps(rec, indent=2)
     print(text)
     if a.json:
