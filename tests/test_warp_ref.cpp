@@ -160,8 +160,8 @@ TEST_F(WarpRef, WallAndVisceraSeparateAlongTheInterfaceAndTheGapIsGas) {
   EXPECT_EQ(r.gas_voxels, gas);
 }
 
-// The result does not depend on the thread count (slabs own their voxels; tetrahedra are visited
-// in index order). A smooth random deformation with per-node jitter; compared bit for bit.
+// The result does not depend on the thread count (a tile's voxels belong to one thread at a time,
+// and the lowest accepting index wins by comparison, not by visiting order). A smooth random deformation with per-node jitter; compared bit for bit.
 TEST_F(WarpRef, SameBitsOnOneAndTwoThreads) {
   const WarpCase c = make_warp_case(grid_of({24, 20, 16}, {0.8, 0.8, 1.6}, rotation(-15, Vec3(0, 1, 1))), 4, 15);
   std::mt19937 rng(15);
@@ -180,6 +180,38 @@ TEST_F(WarpRef, SameBitsOnOneAndTwoThreads) {
   EXPECT_EQ(one.labels, two.labels);
   EXPECT_EQ(one.outcome, two.outcome);
   EXPECT_GT(one.carried_voxels, 0);
+}
+
+// The reference scatters the tetrahedra of one rest cube together, at most 8 to a group. Declaring
+// the whole grid one cube puts every tetrahedron of a part into one key, so groups of 8 consecutive
+// indices span the mesh and overlap everywhere: who wins must not change. Same voxels carried, same
+// labels; HU within 1e-3 (the rows start from other corners, so source points differ by rounding,
+// ~1e-13 voxel). Voxels carried by none may differ: the rest space is now the whole grid (gas, not kept).
+TEST_F(WarpRef, GroupingTheTetrahedraDoesNotChangeWhoWins) {
+  const WarpCase c = make_warp_case(grid_of({24, 20, 16}, {0.8, 0.8, 1.6}, rotation(-15, Vec3(0, 1, 1))), 4, 16);
+  auto u = displacement_of(c, [&](const Vec3& x) {
+    return Vec3(x + Vec3(1.5 * std::sin(x[1] / 5.0), 1.0 * std::cos(x[0] / 4.0), 0.8 * std::sin(x[2] / 3.0)));
+  });
+  const WarpMesh by_cube = make_warp_mesh(c.mesh, u);
+  WarpMesh one_cube = by_cube;
+  one_cube.cube_voxels = 24;
+  one_cube.cubes = {1, 1, 1};
+  one_cube.cube_meshed = {1};
+  const WarpResult a = warp_ref(by_cube, c.source(), c.whole(), options());
+  const WarpResult b = warp_ref(one_cube, c.source(), c.whole(), options());
+  int64_t carried = 0, differ = 0;
+  double max_hu = 0;
+  for (std::size_t n = 0; n < a.outcome.size(); ++n) {
+    const bool in_a = a.outcome[n] == WarpOutcome::Carried, in_b = b.outcome[n] == WarpOutcome::Carried;
+    if (!in_a && !in_b) continue;
+    ++carried;
+    differ += in_a != in_b || a.labels[n] != b.labels[n];
+    max_hu = std::max(max_hu, double(std::abs(a.ct_hu[n] - b.ct_hu[n])));
+  }
+  EXPECT_EQ(differ, 0);
+  EXPECT_LE(max_hu, 1e-3);
+  EXPECT_GT(carried, 1000);
+  EXPECT_GT(by_cube.tet_count(), 8 * 2);
 }
 
 // A box inside the working grid (the CT inside the roles' padding): the output is the box's voxels

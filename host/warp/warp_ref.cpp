@@ -3,13 +3,13 @@
 //
 // Scatter without atomics: the output is cut into tiles small enough that a tile's output and the
 // source it reads stay in a core's L2 cache (a voxel's trilinear stencil and role lookup are
-// gathers). Where tetrahedra are small the rows through them are short, and each row's set-up
-// (its span, its first source point) costs as much as its voxels: both are kept to a few
-// multiply-adds. Each tetrahedron is listed,
-// in index order, under every tile its bounding box touches. One thread owns a tile at a time and
-// visits its tetrahedra in ascending order, so "the lowest accepting index wins" is "the first
-// accepting one wins", whatever the thread count: the first one samples the CT and labels at its
-// source point there and then, and later ones leave the voxel alone.
+// gathers). One thread owns a tile at a time. Where tetrahedra are small the rows through them are
+// short (2.5 voxels on average for 8-voxel cubes), and a row's set-up costs as much as its voxels:
+// so the tetrahedra of one rest cube go together, one pass along each row through the cube serving
+// all five, each voxel going to the lowest-indexed of them that holds it. Across groups (shared
+// faces, meshes pressed into each other) a per-voxel owner index keeps "the lowest accepting index
+// wins" independent of the order groups come in, whatever the thread count; the winner samples the
+// CT and labels at its source point there and then.
 #include <omp.h>
 
 #include <algorithm>
@@ -72,7 +72,7 @@ RefTet prepare(const WarpMesh& m, int64_t t, const WarpBox& box) {
   r.part = m.tet_part[std::size_t(t)];
   r.w_step[0] = -r.e_inv.col(0).sum();
   for (int c = 0; c < 3; ++c) r.w_step[1 + c] = r.e_inv(c, 0);
-  for (int c = 0; c < 4; ++c) r.w_step_inv[c] = 1.0 / r.w_step[c];   // ±inf for 0: row_span looks at the sign first
+  for (int c = 0; c < 4; ++c) r.w_step_inv[c] = 1.0 / r.w_step[c];   // ±inf for 0: lane_start looks at the sign first
   r.skip = false;
   for (int a = 0; a < 3; ++a) {
     double lo = x[0][a], hi = x[0][a];
@@ -95,25 +95,6 @@ RefTet prepare(const WarpMesh& m, int64_t t, const WarpBox& box) {
   return r;
 }
 
-/// The voxels of a row from i_lo to i_hi inside tetrahedron r, given its weights 1..3 at i_lo. Along
-/// the row each barycentric weight is affine in i, w_c(i_lo + t) = w_c(i_lo) + t·step_c, so "every
-/// weight ≥ −tolerance" is an interval of t bounded by (−tolerance − w_c(i_lo)) / step_c: the
-/// containment test solved for the row at once instead of evaluated voxel by voxel. (The two differ
-/// only for a voxel whose weight lies within rounding, 1e-15 relative, of −tolerance: a tie by any
-/// reckoning.) Empty when first > last.
-std::pair<int64_t, int64_t> row_span(const RefTet& r, int64_t i_lo, int64_t i_hi, const Vec3& w_lo) {
-  const double w_first[4] = {1.0 - w_lo.sum(), w_lo[0], w_lo[1], w_lo[2]};
-  double t_lo = 0.0, t_hi = double(i_hi - i_lo);
-  for (int c = 0; c < 4; ++c) {   // w_first + w_step·t ≥ −tolerance
-    const double bound = (-kWarpTolerance - w_first[c]) * r.w_step_inv[c];
-    if (r.w_step[c] > 0) t_lo = std::max(t_lo, bound);
-    else if (r.w_step[c] < 0) t_hi = std::min(t_hi, bound);
-    else if (w_first[c] < -kWarpTolerance) t_hi = -1.0;
-  }
-  if (!(t_lo <= t_hi)) return {1, 0};   // also for NaN
-  return {i_lo + ceil_to_int(t_lo), i_lo + floor_to_int(t_hi)};
-}
-
 /// Whether each cube of row (j, k) was meshed at rest, indexed by cube_of_i[i]; null when the row
 /// lies beyond the lattice.
 const uint8_t* rest_row(const WarpMesh& m, int64_t j, int64_t k) {
@@ -122,39 +103,210 @@ const uint8_t* rest_row(const WarpMesh& m, int64_t j, int64_t k) {
   return m.cube_meshed.data() + m.cubes[0] * (b + m.cubes[1] * c);
 }
 
-/// The output the scatter writes, its outcome doubling as the scatter's state: Kept = inside no
-/// tetrahedron yet, Gas = inside one that refused its source, Carried = taken (and sampled) by the
-/// first, so lowest-indexed, accepting one.
+/// What the scatter writes, its outcome doubling as its state: Kept = inside no tetrahedron yet,
+/// Gas = inside one that refused its source, Carried = sampled by an accepting one.
 struct ScatterOutput {
   WarpOutcome* outcome;
   float* hu;
   uint16_t* label;   // null: no label output
 };
 
-/// Voxels row + 0 … row + count of one row inside tetrahedron r, whose source points are
-/// source0 + t · step. Interior: r.interior holds, so no source point needs a bounds check.
-/// Returns how many voxels it carried.
-template <bool Interior>
-int64_t scatter_row(const RefTet& r, const SourceGrid& grid, const Vec3& source0, const Vec3& step, int64_t count,
-                    std::size_t row, const ScatterOutput& out) {
-  int64_t carried = 0;
-  for (int64_t t = 0; t <= count; ++t) {
-    const std::size_t n = row + std::size_t(t);
-    if (out.outcome[n] == WarpOutcome::Carried) continue;   // a lower index already took it
-    const Vec3 from = source0 + double(t) * step;
-    const int64_t v = Interior ? grid.nearest_interior(from) : grid.nearest(from);
-    const Role role = v < 0 ? Role::Other : grid.roles[v];
-    if (r.part == Part::Wall ? role == Role::Viscera : role == Role::Wall) {
-      out.outcome[n] = WarpOutcome::Gas;   // covered; gas unless a later tetrahedron accepts it
-      continue;
+/// Per voxel of a tile, the lowest accepting tetrahedron index so far: groups overlap (shared faces,
+/// tetrahedra pressed into each other), and comparing indices, not visiting order, makes the lowest
+/// accepting index win.
+constexpr int32_t kNoOwner = INT32_MAX;
+
+/// Tetrahedra served by one pass along each row: one rest cube's of one part (the five of a lattice
+/// cube), ascending index. Rows through a cube are a few voxels long inside each of its tetrahedra
+/// but about L long through the cube, so one row set-up replaces five short loops.
+constexpr int kMaxGroup = 8;
+
+struct TetGroup {
+  int32_t first, count;   // the prepared tetrahedra first .. first + count − 1 (skipped ones among them)
+  Index3 lo, hi;          // the union of their bounding boxes
+  Part part;
+  bool interior;          // every one RefTet::interior
+};
+
+/// The order the tetrahedra are prepared and scattered in: by rest cube (the cube holding their rest
+/// centroid) and part, ascending index within each, a counting sort. Stored in this order, a group's
+/// tetrahedra are adjacent in memory however the mesh numbers them (the peers' mesh numbers its five
+/// patterns apart), so a tile reads them as a stream rather than one cache miss each. Any order and
+/// grouping give the same result (owners decide); this one gives long rows.
+struct CubeOrder {
+  std::vector<int32_t> tets;   // tetrahedron indices in cube order
+  std::vector<int32_t> start;  // per (cube, part) key, where its tetrahedra begin in `tets`; one more at the end
+};
+
+CubeOrder cube_order(const WarpMesh& m) {
+  const int64_t T = m.tet_count();
+  const double L = double(std::max(1, m.cube_voxels));
+  const int64_t keys = 2 * m.cubes[0] * m.cubes[1] * m.cubes[2];
+  std::vector<int64_t> key(static_cast<std::size_t>(T));
+#pragma omp parallel for schedule(static)
+  for (int64_t t = 0; t < T; ++t) {
+    const auto& v = m.tets[std::size_t(t)];
+    const Vec3 c = 0.25 * (m.rest_ijk[v[0]] + m.rest_ijk[v[1]] + m.rest_ijk[v[2]] + m.rest_ijk[v[3]]);
+    int64_t q = 0;
+    for (int a = 2; a >= 0; --a) {   // cube a spans [aL − ½, (a+1)L − ½); clamped for meshes off the lattice
+      const double at = std::clamp(std::floor((c[a] + 0.5) / L), 0.0, double(m.cubes[a] - 1));
+      q = q * m.cubes[a] + int64_t(at);
     }
-    out.outcome[n] = WarpOutcome::Carried;
-    if (Interior) out.hu[n] = float(grid.ct_trilinear_interior(from));
-    else out.hu[n] = v < 0 ? float(SourceGrid::kOutsideHu) : float(grid.ct_trilinear_inside(from));
-    if (out.label) out.label[n] = v < 0 ? uint16_t(0) : grid.labels[v];
-    ++carried;
+    key[std::size_t(t)] = 2 * q + int64_t(m.tet_part[std::size_t(t)]);
+  }
+  CubeOrder out;
+  out.start.assign(std::size_t(keys + 1), 0);
+  for (int64_t k : key) ++out.start[std::size_t(k + 1)];
+  for (int64_t k = 0; k < keys; ++k) out.start[std::size_t(k + 1)] += out.start[std::size_t(k)];
+  out.tets.resize(std::size_t(T));
+  std::vector<int32_t> next(out.start.begin(), out.start.end() - 1);
+  for (int64_t t = 0; t < T; ++t) out.tets[std::size_t(next[std::size_t(key[std::size_t(t)])]++)] = int32_t(t);
+  return out;
+}
+
+/// The groups of up to kMaxGroup adjacent prepared tetrahedra of one (cube, part) key; none where all are
+/// skipped.
+std::vector<TetGroup> group_tetrahedra(const CubeOrder& order, const RefTet* prepared) {
+  std::vector<TetGroup> groups;
+  for (std::size_t k = 0; k + 1 < order.start.size(); ++k)
+    for (int32_t b = order.start[k]; b < order.start[k + 1]; b += kMaxGroup) {
+      TetGroup g;
+      g.first = b;
+      g.count = std::min(kMaxGroup, order.start[k + 1] - b);
+      g.lo = {INT64_MAX, INT64_MAX, INT64_MAX}, g.hi = {INT64_MIN, INT64_MIN, INT64_MIN};
+      g.interior = true;
+      bool any = false;
+      for (int32_t n = b; n < b + g.count; ++n) {
+        const RefTet& r = prepared[n];
+        if (r.skip) continue;
+        any = true;
+        g.part = r.part;
+        for (int a = 0; a < 3; ++a) g.lo[a] = std::min(g.lo[a], r.lo[a]), g.hi[a] = std::max(g.hi[a], r.hi[a]);
+        g.interior &= r.interior;
+      }
+      if (any) groups.push_back(g);
+    }
+  return groups;
+}
+
+/// A group's tetrahedra along one row: lane g is tetrahedron index[g], covering offsets
+/// first[g] .. last[g] from the row's origin, where its source point is src[·][g] + t · step[·][g].
+/// A lane covering nothing has first > last.
+struct RowLanes {
+  alignas(16) int32_t first[kMaxGroup];
+  alignas(16) int32_t last[kMaxGroup];
+  int32_t index[kMaxGroup];
+  double src[3][kMaxGroup], step[3][kMaxGroup];
+
+  /// The lanes covering offset t, one bit each, lane 0 lowest.
+  unsigned covering(int32_t t) const {
+#if defined(__SSE2__)
+    static_assert(kMaxGroup == 8, "two SSE2 vectors of lanes");
+    const __m128i at = _mm_set1_epi32(t);
+    auto outside = [&](int from) {   // lanes from .. from + 3 with first > t or t > last
+      const __m128i f = _mm_load_si128(reinterpret_cast<const __m128i*>(first + from));
+      const __m128i l = _mm_load_si128(reinterpret_cast<const __m128i*>(last + from));
+      return unsigned(_mm_movemask_ps(_mm_castsi128_ps(_mm_or_si128(_mm_cmpgt_epi32(f, at), _mm_cmpgt_epi32(at, l)))));
+    };
+    return ~(outside(0) | outside(4) << 4) & 0xFFu;
+#else
+    unsigned m = 0;
+    for (int g = 0; g < kMaxGroup; ++g) m |= unsigned(first[g] <= t && t <= last[g]) << g;
+    return m;
+#endif
+  }
+};
+
+/// Offsets t_lo .. t_hi of one row through a group of `part`: each voxel goes to the lowest-indexed
+/// lane covering it whose source role accepts, unless its owner is lower still. `row` and `owner`
+/// are the row's origin in the output and in the tile's owners. Interior: every lane's source points
+/// lie inside the grid, so none needs a bounds check. Returns how many voxels it carried first.
+template <bool Interior>
+int64_t scatter_row(const RowLanes& lanes, int32_t t_lo, int32_t t_hi, Part part, const SourceGrid& grid,
+                    std::size_t row, int32_t* owner, const ScatterOutput& out) {
+  int64_t carried = 0;
+  for (int32_t t = t_lo; t <= t_hi; ++t) {
+    const std::size_t n = row + std::size_t(t);
+    for (unsigned mask = lanes.covering(t); mask; mask &= mask - 1) {
+      const int g = __builtin_ctz(mask);
+      if (lanes.index[g] > owner[t]) break;   // a lower index took it (the lanes ascend)
+      const Vec3 from(lanes.src[0][g] + double(t) * lanes.step[0][g], lanes.src[1][g] + double(t) * lanes.step[1][g],
+                      lanes.src[2][g] + double(t) * lanes.step[2][g]);
+      const int64_t v = Interior ? grid.nearest_interior(from) : grid.nearest(from);
+      const Role role = v < 0 ? Role::Other : grid.roles[v];
+      if (part == Part::Wall ? role == Role::Viscera : role == Role::Wall) {
+        if (owner[t] == kNoOwner) out.outcome[n] = WarpOutcome::Gas;   // gas unless another accepts it
+        continue;
+      }
+      carried += owner[t] == kNoOwner;
+      owner[t] = lanes.index[g];
+      out.outcome[n] = WarpOutcome::Carried;
+      if (Interior) out.hu[n] = float(grid.ct_trilinear_interior(from));
+      else out.hu[n] = v < 0 ? float(SourceGrid::kOutsideHu) : float(grid.ct_trilinear_inside(from));
+      if (out.label) out.label[n] = v < 0 ? uint16_t(0) : grid.labels[v];
+      break;
+    }
   }
   return carried;
+}
+
+/// Where a row (j, k) of the box a group is scattered over in a tile crosses one of its tetrahedra.
+/// Along a row each barycentric weight is affine in the offset t from the box's corner,
+/// w_c = w_c(row) + t·step_c, so "every weight ≥ −tolerance" is an interval of t: the containment
+/// test solved for the row at once instead of evaluated voxel by voxel. Its bounds
+/// (−tolerance − w_c(row)) / step_c are themselves affine in the row's offsets (dj, dk), so each
+/// is bound[c] + dj·bound_j[c] + dk·bound_k[c]: a lower bound where step_c > 0, an upper one where
+/// step_c < 0. (This differs from testing voxel by voxel only for a voxel whose weight lies within
+/// rounding, 1e-15 relative, of −tolerance: a tie by any reckoning.) The other side's slot holds a
+/// bound that never binds, so a row's span takes no branches. A weight constant along i (step_c = 0,
+/// faces parallel to i) either holds along the whole row or fails it: its (−tolerance − w_c(row)),
+/// scaled by 2^900 (exactly, so its sign is kept), sits among the lower bounds, where any positive
+/// value empties the row and any other does nothing.
+struct LaneStart {
+  double lower[3][4], upper[3][4];   // [0]: at the corner, [1]: per row along j, [2]: along k
+  Vec3 src, src_j, src_k;            // source point at the corner, and per row along j and k
+};
+
+constexpr double kNeverBinds = 1e300;
+constexpr double kConstantScale = 0x1p900;
+
+/// A lane that covers no row: a skipped tetrahedron among its group's.
+LaneStart empty_lane() {
+  LaneStart s{};
+  for (int c = 0; c < 4; ++c) s.lower[0][c] = s.upper[0][c] = kNeverBinds;
+  return s;
+}
+
+LaneStart lane_start(const RefTet& r, const Vec3& corner) {
+  if (r.skip) return empty_lane();
+  LaneStart s;
+  const Vec3 w = r.e_inv * (corner - r.x0);
+  const double w_at[4] = {1.0 - w.sum(), w[0], w[1], w[2]};
+  const double w_j[4] = {-r.e_inv.col(1).sum(), r.e_inv(0, 1), r.e_inv(1, 1), r.e_inv(2, 1)};
+  const double w_k[4] = {-r.e_inv.col(2).sum(), r.e_inv(0, 2), r.e_inv(1, 2), r.e_inv(2, 2)};
+  for (int c = 0; c < 4; ++c) {
+    const double at = -kWarpTolerance - w_at[c];
+    double(*bound)[4] = r.w_step[c] < 0 ? s.upper : s.lower;
+    double(*other)[4] = r.w_step[c] < 0 ? s.lower : s.upper;
+    const double scale = r.w_step[c] == 0 ? kConstantScale : r.w_step_inv[c];
+    bound[0][c] = at * scale, bound[1][c] = -w_j[c] * scale, bound[2][c] = -w_k[c] * scale;
+    other[0][c] = r.w_step[c] < 0 ? -kNeverBinds : kNeverBinds, other[1][c] = 0.0, other[2][c] = 0.0;
+  }
+  s.src = corner - (r.d0 + r.dd * w);
+  s.src_j = Vec3::Unit(1) - r.dd * r.e_inv.col(1);
+  s.src_k = Vec3::Unit(2) - r.dd * r.e_inv.col(2);
+  return s;
+}
+
+/// The offsets of row (dj, dk) inside the lane, clipped to 0 .. t_max; first > last when none.
+inline std::pair<int32_t, int32_t> row_span(const LaneStart& s, double dj, double dk, int32_t t_max) {
+  double t_lo = 0.0, t_hi = double(t_max);
+  for (int c = 0; c < 4; ++c) {
+    t_lo = std::max(t_lo, s.lower[0][c] + dj * s.lower[1][c] + dk * s.lower[2][c]);
+    t_hi = std::min(t_hi, s.upper[0][c] + dj * s.upper[1][c] + dk * s.upper[2][c]);
+  }
+  if (!(t_lo <= t_hi)) return {1, 0};
+  return {int32_t(ceil_to_int(t_lo)), int32_t(floor_to_int(t_hi))};
 }
 
 }  // namespace
@@ -184,23 +336,26 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
       if (t.joinable()) t.join();
     }
   } join_allocate{allocate};
-  const std::unique_ptr<RefTet[]> tets(new RefTet[std::size_t(T)]);
+  const CubeOrder order = cube_order(mesh);
+  timer.lap("order");
+  const std::unique_ptr<RefTet[]> tets(new RefTet[std::size_t(T)]);   // in cube order
 #pragma omp parallel for schedule(static)
-  for (int64_t t = 0; t < T; ++t) tets[std::size_t(t)] = prepare(mesh, t, box);
+  for (int64_t n = 0; n < T; ++n) tets[std::size_t(n)] = prepare(mesh, order.tets[std::size_t(n)], box);
   timer.lap("tetrahedra");
+  const std::vector<TetGroup> groups = group_tetrahedra(order, tets.get());
+  timer.lap("groups");
 
   Index3 tiles;
   for (int a = 0; a < 3; ++a) tiles[a] = (box.dims[a] + kTile[a] - 1) / kTile[a];
   const int64_t n_tiles = tiles[0] * tiles[1] * tiles[2];
   auto tile_of = [&](int a, int64_t i) { return (i - box.lo[a]) / kTile[a]; };
   std::vector<std::vector<int32_t>> by_tile(static_cast<std::size_t>(n_tiles));
-  for (int64_t t = 0; t < T; ++t) {
-    const RefTet& r = tets[std::size_t(t)];
-    if (r.skip) continue;
-    for (int64_t c = tile_of(2, r.lo[2]); c <= tile_of(2, r.hi[2]); ++c)
-      for (int64_t b = tile_of(1, r.lo[1]); b <= tile_of(1, r.hi[1]); ++b)
-        for (int64_t a = tile_of(0, r.lo[0]); a <= tile_of(0, r.hi[0]); ++a)
-          by_tile[std::size_t(a + tiles[0] * (b + tiles[1] * c))].push_back(int32_t(t));
+  for (std::size_t n = 0; n < groups.size(); ++n) {
+    const TetGroup& g = groups[n];
+    for (int64_t c = tile_of(2, g.lo[2]); c <= tile_of(2, g.hi[2]); ++c)
+      for (int64_t b = tile_of(1, g.lo[1]); b <= tile_of(1, g.hi[1]); ++b)
+        for (int64_t a = tile_of(0, g.lo[0]); a <= tile_of(0, g.hi[0]); ++a)
+          by_tile[std::size_t(a + tiles[0] * (b + tiles[1] * c))].push_back(int32_t(n));
   }
 
   timer.lap("tiles");
@@ -224,76 +379,95 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
   WarpOutcome* const outcome = state.outcome;
   float* const hu = state.hu;
   uint16_t* const label = state.label;
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : carried, gas, kept)
-  for (int64_t n_tile = 0; n_tile < n_tiles; ++n_tile) {
-    Tile tile;
-    const Index3 at{n_tile % tiles[0], (n_tile / tiles[0]) % tiles[1], n_tile / (tiles[0] * tiles[1])};
-    for (int a = 0; a < 3; ++a) {
-      tile.lo[a] = box.lo[a] + at[a] * kTile[a];
-      tile.hi[a] = std::min(tile.lo[a] + kTile[a], box.lo[a] + box.dims[a]) - 1;
-    }
-    int64_t tile_carried = 0;
-    // 1. Scatter and sample: every tetrahedron over its bounding box inside this tile, ascending
-    // index. The weights w and the source point P′ − (d₀ + D w) are affine in the voxel index, so
-    // each row starts from its value at the box's corner plus the row's offsets times its steps,
-    // and each voxel adds its offset along the row times the step along i. Equal displacements
-    // make D zero, so an identity or a whole-voxel translation still lands on whole voxels exactly.
-    for (int32_t t : by_tile[std::size_t(n_tile)]) {
-      const RefTet& r = tets[std::size_t(t)];
-      const Index3 lo{std::max(r.lo[0], tile.lo[0]), std::max(r.lo[1], tile.lo[1]), std::max(r.lo[2], tile.lo[2])};
-      const Index3 hi{std::min(r.hi[0], tile.hi[0]), std::min(r.hi[1], tile.hi[1]), std::min(r.hi[2], tile.hi[2])};
-      const Vec3 corner(static_cast<double>(lo[0]), static_cast<double>(lo[1]), static_cast<double>(lo[2]));
-      const Vec3 w_corner = r.e_inv * (corner - r.x0);
-      const Vec3 source_corner = corner - (r.d0 + r.dd * w_corner);
-      Vec3 w_along[3], source_along[3];   // per voxel along i, j, k
+#pragma omp parallel reduction(+ : carried, gas, kept)
+  {
+    std::vector<int32_t> owner(std::size_t(kTile[0] * kTile[1] * kTile[2]));
+    RowLanes lanes;
+    LaneStart start[kMaxGroup];
+#pragma omp for schedule(dynamic, 1)
+    for (int64_t n_tile = 0; n_tile < n_tiles; ++n_tile) {
+      Tile tile;
+      const Index3 at{n_tile % tiles[0], (n_tile / tiles[0]) % tiles[1], n_tile / (tiles[0] * tiles[1])};
       for (int a = 0; a < 3; ++a) {
-        w_along[a] = r.e_inv.col(a);
-        source_along[a] = Vec3::Unit(a) - r.dd * w_along[a];
+        tile.lo[a] = box.lo[a] + at[a] * kTile[a];
+        tile.hi[a] = std::min(tile.lo[a] + kTile[a], box.lo[a] + box.dims[a]) - 1;
       }
-      for (int64_t k = lo[2]; k <= hi[2]; ++k)
-        for (int64_t j = lo[1]; j <= hi[1]; ++j) {
-          const double dj = double(j - lo[1]), dk = double(k - lo[2]);
-          const Vec3 w_row = w_corner + dj * w_along[1] + dk * w_along[2];
-          const auto [first, last] = row_span(r, lo[0], hi[0], w_row);
-          if (first > last) continue;
-          const double di = double(first - lo[0]);
-          const Vec3 source0 = source_corner + di * source_along[0] + dj * source_along[1] + dk * source_along[2];
-          const std::size_t row = out_index(first, j, k);
-          tile_carried += r.interior ? scatter_row<true>(r, grid, source0, source_along[0], last - first, row, state)
-                                     : scatter_row<false>(r, grid, source0, source_along[0], last - first, row, state);
+      const int64_t tw = tile.hi[0] - tile.lo[0] + 1, th = tile.hi[1] - tile.lo[1] + 1;
+      const int64_t tile_voxels = tw * th * (tile.hi[2] - tile.lo[2] + 1);
+      std::fill_n(owner.begin(), tile_voxels, kNoOwner);
+      int64_t tile_carried = 0;
+      // 1. Scatter and sample, group by group over the box their bounding boxes share with this tile.
+      // A tetrahedron's weights w and source point P′ − (d₀ + D w) are affine in the voxel index, so
+      // each row starts from their value at the box's corner plus the row's offsets times their
+      // steps, and each voxel adds its offset along the row times the step along i. Equal
+      // displacements make D zero, so an identity or a whole-voxel translation still lands on whole
+      // voxels exactly.
+      for (int32_t n_group : by_tile[std::size_t(n_tile)]) {
+        const TetGroup& group = groups[std::size_t(n_group)];
+        Index3 lo, hi;
+        for (int a = 0; a < 3; ++a) lo[a] = std::max(group.lo[a], tile.lo[a]), hi[a] = std::min(group.hi[a], tile.hi[a]);
+        const Vec3 corner(static_cast<double>(lo[0]), static_cast<double>(lo[1]), static_cast<double>(lo[2]));
+        for (int g = 0; g < kMaxGroup; ++g) lanes.first[g] = 1, lanes.last[g] = 0;
+        for (int g = 0; g < group.count; ++g) {
+          const RefTet& r = tets[std::size_t(group.first + g)];
+          const int32_t t = order.tets[std::size_t(group.first + g)];
+          start[g] = lane_start(r, corner);
+          if (r.skip) continue;
+          const Vec3 step = Vec3::Unit(0) - r.dd * r.e_inv.col(0);
+          for (int a = 0; a < 3; ++a) lanes.step[a][g] = step[a];
+          lanes.index[g] = t;
         }
+        const int32_t t_max = int32_t(hi[0] - lo[0]);
+        for (int64_t k = lo[2]; k <= hi[2]; ++k)
+          for (int64_t j = lo[1]; j <= hi[1]; ++j) {
+            const double dj = double(j - lo[1]), dk = double(k - lo[2]);
+            int32_t t_lo = INT32_MAX, t_hi = INT32_MIN;
+            for (int g = 0; g < group.count; ++g) {
+              const LaneStart& s = start[g];
+              const auto [first, last] = row_span(s, dj, dk, t_max);
+              lanes.first[g] = first, lanes.last[g] = last;
+              if (first > last) continue;
+              t_lo = std::min(t_lo, first), t_hi = std::max(t_hi, last);
+              const Vec3 src_row = s.src + dj * s.src_j + dk * s.src_k;
+              for (int a = 0; a < 3; ++a) lanes.src[a][g] = src_row[a];
+            }
+            if (t_lo > t_hi) continue;
+            const std::size_t row = out_index(lo[0], j, k);
+            int32_t* const own = owner.data() + (lo[0] - tile.lo[0]) + tw * ((j - tile.lo[1]) + th * (k - tile.lo[2]));
+            tile_carried += group.interior ? scatter_row<true>(lanes, t_lo, t_hi, group.part, grid, row, own, state)
+                                           : scatter_row<false>(lanes, t_lo, t_hi, group.part, grid, row, own, state);
+          }
+      }
+      // 2. What no tetrahedron took: gas inside the meshes' space before or after deformation,
+      // otherwise the voxel's own value. Nothing to do in a tile carried whole.
+      if (tile_carried == tile_voxels) carried += tile_voxels;
+      else for (int64_t k = tile.lo[2]; k <= tile.hi[2]; ++k)
+        for (int64_t j = tile.lo[1]; j <= tile.hi[1]; ++j) {
+          const uint8_t* meshed_row = rest_row(mesh, j, k);
+          const std::size_t row = out_index(tile.lo[0], j, k);
+          const int64_t v_row = mesh.grid.linear_index(0, j, k);
+          for (int64_t i = tile.lo[0]; i <= tile.hi[0]; ++i) {
+            const std::size_t n = row + std::size_t(i - tile.lo[0]);
+            WarpOutcome& what = outcome[n];
+            if (what == WarpOutcome::Carried) {
+              ++carried;
+              continue;
+            }
+            if (what == WarpOutcome::Kept && meshed_row && meshed_row[cube_of_i[std::size_t(i)]]) what = WarpOutcome::Gas;
+            if (what == WarpOutcome::Gas) {
+              ++gas;
+              hu[n] = opt.gas_hu;
+              if (label) label[n] = opt.cavity_label;
+            } else {
+              ++kept;
+              hu[n] = src.ct_hu[v_row + i];
+              if (label) label[n] = src.labels[v_row + i];
+            }
+          }
+        }
+      const int64_t d = ++done;
+      if (omp_get_thread_num() == 0) progress.update(d);
     }
-    // 2. What no tetrahedron took: gas inside the meshes' space before or after deformation,
-    // otherwise the voxel's own value. Nothing to do in a tile carried whole.
-    const int64_t tile_voxels =
-        (tile.hi[0] - tile.lo[0] + 1) * (tile.hi[1] - tile.lo[1] + 1) * (tile.hi[2] - tile.lo[2] + 1);
-    if (tile_carried == tile_voxels) carried += tile_voxels;
-    else for (int64_t k = tile.lo[2]; k <= tile.hi[2]; ++k)
-      for (int64_t j = tile.lo[1]; j <= tile.hi[1]; ++j) {
-        const uint8_t* meshed_row = rest_row(mesh, j, k);
-        const std::size_t row = out_index(tile.lo[0], j, k);
-        const int64_t v_row = mesh.grid.linear_index(0, j, k);
-        for (int64_t i = tile.lo[0]; i <= tile.hi[0]; ++i) {
-          const std::size_t n = row + std::size_t(i - tile.lo[0]);
-          WarpOutcome& what = outcome[n];
-          if (what == WarpOutcome::Carried) {
-            ++carried;
-            continue;
-          }
-          if (what == WarpOutcome::Kept && meshed_row && meshed_row[cube_of_i[std::size_t(i)]]) what = WarpOutcome::Gas;
-          if (what == WarpOutcome::Gas) {
-            ++gas;
-            hu[n] = opt.gas_hu;
-            if (label) label[n] = opt.cavity_label;
-          } else {
-            ++kept;
-            hu[n] = src.ct_hu[v_row + i];
-            if (label) label[n] = src.labels[v_row + i];
-          }
-        }
-      }
-    const int64_t d = ++done;
-    if (omp_get_thread_num() == 0) progress.update(d);
   }
   progress.finish();
   out.carried_voxels = carried;
