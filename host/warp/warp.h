@@ -1,7 +1,7 @@
 #pragma once
 // The barycentric image warp (method.md §7; Kitasaka §2.5, Nimura §2.4): the deformed CT and label
 // map from the rest and deformed meshes. Two implementations behind one interface: warp_ref (plain
-// C++, double precision, OpenMP over slabs, the oracle) and warp_opencl (kernels/warp.cl, float).
+// C++, double precision, OpenMP over tiles, the oracle) and warp_opencl (kernels/warp.cl, float).
 //
 // For each output voxel centre P′ (index coordinates of the working grid, warp_mesh.h):
 //  1. Scatter: each deformed tetrahedron visits the voxel centres of its bounding box; P′ is inside

@@ -28,10 +28,10 @@ namespace pneumo {
 
 namespace {
 
-// Output voxels per tile along i, j, k: 16 K voxels, whose outputs (7 B each) and source stencils
-// take a few hundred KiB of a 1–2 MiB L2. Long rows matter most: a tetrahedron cut by a tile's
-// i-face costs each of its rows twice, so 256 (on the peers' case a little faster than 64 or 128,
-// bench/results/2026-12-01-warp.md); 8 planes match the usual cube size, so a tetrahedron spans two.
+// Output voxels per tile along i, j, k: 16 K voxels, whose outputs (7 B each), owners (4 B) and
+// source stencils take a few hundred KiB of a 0.5–2 MiB L2. Long rows matter most: a group cut by a
+// tile's i-face costs each of its rows twice, so 256 (on the peers' case a little faster than 64 or
+// 128, bench/results/2026-12-01-warp.md); 8 planes match the usual cube size, so a group spans two.
 constexpr Index3 kTile{256, 8, 8};
 
 /// One deformed tetrahedron, ready for containment tests. No default member values: the table of them
