@@ -264,7 +264,7 @@ int64_t scatter_row(const RowLanes& lanes, int32_t t_lo, int32_t t_hi, Part part
 /// value empties the row and any other does nothing.
 struct LaneStart {
   double lower[3][4], upper[3][4];   // [0]: at the corner, [1]: per row along j, [2]: along k
-  Vec3 src, src_j, src_k;            // source point at the corner, and per row along j and k
+  Vec3 src, src_i, src_j, src_k;     // source point at the corner, per voxel along i, per row along j and k
 };
 
 constexpr double kNeverBinds = 1e300;
@@ -293,6 +293,7 @@ LaneStart lane_start(const RefTet& r, const Vec3& corner) {
     other[0][c] = r.w_step[c] < 0 ? -kNeverBinds : kNeverBinds, other[1][c] = 0.0, other[2][c] = 0.0;
   }
   s.src = corner - (r.d0 + r.dd * w);
+  s.src_i = Vec3::Unit(0) - r.dd * r.e_inv.col(0);
   s.src_j = Vec3::Unit(1) - r.dd * r.e_inv.col(1);
   s.src_k = Vec3::Unit(2) - r.dd * r.e_inv.col(2);
   return s;
@@ -412,9 +413,7 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
           const RefTet& r = tets[std::size_t(group.first + g)];
           const int32_t t = order.tets[std::size_t(group.first + g)];
           start[g] = lane_start(r, corner);
-          if (r.skip) continue;
-          const Vec3 step = Vec3::Unit(0) - r.dd * r.e_inv.col(0);
-          for (int a = 0; a < 3; ++a) lanes.step[a][g] = step[a];
+          for (int a = 0; a < 3; ++a) lanes.step[a][g] = start[g].src_i[a];
           lanes.index[g] = t;
         }
         const int32_t t_max = int32_t(hi[0] - lo[0]);
