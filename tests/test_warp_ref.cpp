@@ -182,6 +182,43 @@ TEST_F(WarpRef, SameBitsOnOneAndTwoThreads) {
   EXPECT_GT(one.carried_voxels, 0);
 }
 
+// A series of warps reuses its memory (WarpSeries): each warp must give the bits a fresh one gives,
+// whatever the last warp left there. Identity after a lift (stale gas), the lift after identity (stale
+// carried voxels), a smaller box (reallocated), then no labels (their output released).
+TEST_F(WarpRef, ASeriesOfWarpsGivesWhatFreshWarpsGive) {
+  const WarpCase c = make_warp_case(grid_of({24, 20, 16}, {0.8, 0.8, 1.6}, rotation(25, Vec3(1, 0, 1))), 4, 17);
+  const WarpMesh lift = make_warp_mesh(c.mesh, displacement_of(c, [&](const Vec3& x) {
+    return Vec3(x + Vec3(0.5 * std::sin(x[1] / 4.0), 2.5 * std::cos(x[0] / 6.0), 1.2));
+  }));
+  const WarpMesh identity = make_warp_mesh(c.mesh, std::vector<Vec3>(std::size_t(c.mesh.node_count()), Vec3::Zero()));
+  WarpSource no_labels = c.source();
+  no_labels.labels = nullptr;
+  struct Step {
+    const WarpMesh* mesh;
+    WarpBox box;
+    WarpSource src;
+  };
+  const Step steps[] = {{&lift, c.whole(), c.source()}, {&identity, c.whole(), c.source()},
+                        {&lift, c.whole(), c.source()}, {&lift, WarpBox{{2, 3, 1}, {19, 15, 13}}, c.source()},
+                        {&identity, c.whole(), no_labels}};
+  WarpSeries series;
+  int n_step = 0;
+  for (const Step& s : steps) {
+    SCOPED_TRACE("step " + std::to_string(n_step++));
+    const WarpResult fresh = warp_ref(*s.mesh, s.src, s.box, options());
+    const WarpResult& again = series.warp("cpu", *s.mesh, s.src, s.box, options());
+    ASSERT_EQ(again.ct_hu.size(), fresh.ct_hu.size());
+    EXPECT_EQ(std::memcmp(again.ct_hu.data(), fresh.ct_hu.data(), fresh.ct_hu.size() * sizeof(float)), 0);
+    EXPECT_EQ(again.labels, fresh.labels);
+    EXPECT_EQ(again.outcome, fresh.outcome);
+    EXPECT_EQ(again.carried_voxels, fresh.carried_voxels);
+    EXPECT_EQ(again.gas_voxels, fresh.gas_voxels);
+    EXPECT_EQ(again.kept_voxels, fresh.kept_voxels);
+    EXPECT_EQ(again.labels.empty(), s.src.labels == nullptr);
+  }
+  EXPECT_GT(warp_ref(lift, c.source(), c.whole(), options()).gas_voxels, 0);
+}
+
 // The reference scatters the tetrahedra of one rest cube together, at most 8 to a group. Declaring
 // the whole grid one cube puts every tetrahedron of a part into one key, so groups of 8 consecutive
 // indices span the mesh and overlap everywhere: no tetrahedron may be lost and no value change. Same

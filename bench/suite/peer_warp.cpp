@@ -210,15 +210,16 @@ json run_peer_warp(const PeerWarpOptions& opt) {
     try {
       std::vector<double> seconds;
       double other = 0.0;
-      WarpResult r;
+      WarpSeries series;   // as ITK's resampling is timed: its output buffer kept between updates
       for (int rep = 0; rep < opt.repeats; ++rep) {
         const CpuSample a = cpu_sample();
         const auto t0 = Clock::now();
-        r = warp_on_device(device, c.mesh, c.source(), c.box, WarpOptions{});
+        series.warp(device, c.mesh, c.source(), c.box, WarpOptions{});
         seconds.push_back(seconds_since(t0));
         other = std::max(other, other_cores(a, cpu_sample()));
       }
       const Summary s = summarize(seconds);
+      const WarpResult& r = series.result();
       runs.push_back({{"device", r.device}, {"seconds", s.median}, {"seconds_all", seconds},
                       {"voxels_per_s", double(grid.voxel_count()) / s.median},
                       {"threads", device == "cpu" ? omp_get_max_threads() : 0}, {"other_cores_max", other},

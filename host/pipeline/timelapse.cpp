@@ -45,7 +45,7 @@ void Timelapse::frame(const SolverSnapshot& snapshot) {
   box.dims = ct_grid_.dims;
   WarpOptions wo;
   wo.cavity_label = uint16_t(scene_.output.cavity_label);
-  const WarpResult w = warp_on_device(scene_.device, wm, src, box, wo);
+  const WarpResult& w = warps_.warp(scene_.device, wm, src, box, wo);
 
   Volume ct(ct_grid_, VoxelType::Float32);
   std::copy(w.ct_hu.begin(), w.ct_hu.end(), ct.data<float>());

@@ -10,6 +10,7 @@
 #include "pipeline/simulate.h"
 #include "render/gl_context.h"
 #include "scene/scene.h"
+#include "warp/warp.h"
 
 namespace pneumo {
 
@@ -30,6 +31,7 @@ class Timelapse {
   GlBackend backend_;
   Geometry ct_grid_;      // the input CT's grid, inside the roles' padded one
   bool labels_;
+  WarpSeries warps_;      // each frame warps into the last one's memory
   int frames_ = 0;
 };
 

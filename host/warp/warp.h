@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "cl/cl_runtime.h"
+#include "core/reusable_buffer.h"
 #include "scene/scene.h"
 #include "warp/warp_mesh.h"
 
@@ -63,6 +64,10 @@ struct WarpResult {
 
 /// The CPU reference. Deterministic for any thread count. Shows Progress("warp").
 WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt);
+/// The same into `out`, reusing its outputs' memory where they already have the box's size, and
+/// `scratch` for the prepared tetrahedra (~300 bytes each): what a series of warps keeps (WarpSeries).
+void warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt,
+              WarpResult& out, ReusableBuffer& scratch);
 
 /// kernels/warp.cl on a device, float32. Checks the device's memory first (ctx.check_fits with
 /// warp_device_bytes).
@@ -75,5 +80,23 @@ uint64_t warp_device_bytes(const WarpMesh& mesh, bool has_labels, const WarpBox&
 /// warp_ref for "cpu", warp_opencl for "opencl" / "opencl:P:D" (InputError for anything else).
 WarpResult warp_on_device(const std::string& device, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,
                           const WarpOptions& opt);
+
+/// Warps one after another into memory kept between them: a time-lapse's frames, a benchmark's
+/// repetitions. The CPU warp of the peers' 512×512×300 case writes 400 MB of outputs and prepares
+/// 240 MB of tetrahedra; faulting that in anew costs 0.3 s or more per warp on the VMs here (seconds
+/// where the host has taken the pages back), a quarter of the warp, so a series faults it in once, as
+/// ITK's filters keep their output buffer between updates. (OpenCL warps allocate their own host outputs.)
+class WarpSeries {
+ public:
+  /// warp_on_device; the result is valid until the next warp.
+  const WarpResult& warp(const std::string& device, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,
+                         const WarpOptions& opt);
+  /// The last warp's result.
+  const WarpResult& result() const { return result_; }
+
+ private:
+  WarpResult result_;
+  ReusableBuffer scratch_;
+};
 
 }  // namespace pneumo

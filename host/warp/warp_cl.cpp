@@ -169,4 +169,13 @@ WarpResult warp_on_device(const std::string& device, const WarpMesh& mesh, const
   return warp_opencl(*ctx, mesh, src, box, opt);
 }
 
+const WarpResult& WarpSeries::warp(const std::string& device, const WarpMesh& mesh, const WarpSource& src,
+                                   const WarpBox& box, const WarpOptions& opt) {
+  if (ocl::parse_device_spec(device).use_opencl) {
+    result_ = WarpResult{};   // the last outputs go before the next are allocated
+    result_ = warp_on_device(device, mesh, src, box, opt);
+  } else warp_ref(mesh, src, box, opt, result_, scratch_);
+  return result_;
+}
+
 }  // namespace pneumo

@@ -17,7 +17,9 @@
 #include <cmath>
 #include <exception>
 #include <memory>
+#include <new>
 #include <thread>
+#include <type_traits>
 
 #include "core/progress.h"
 #include "warp/phase_timer.h"
@@ -313,24 +315,39 @@ inline std::pair<int32_t, int32_t> row_span(const LaneStart& s, double dj, doubl
 }  // namespace
 
 WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt) {
+  WarpResult out;
+  ReusableBuffer scratch;
+  warp_ref(mesh, src, box, opt, out, scratch);
+  return out;
+}
+
+void warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt,
+              WarpResult& out, ReusableBuffer& scratch) {
   check_warp_mesh(mesh);
   PhaseTimer timer("warp on cpu");
   const int64_t T = mesh.tet_count();
-  // The outputs' hundreds of MB are faulted in and zeroed by the kernel on a thread of their own
-  // while the tetrahedra are prepared: each waits on memory, not on the other.
-  WarpResult out;
   out.device = "cpu";
-  const int64_t n_out = box.voxel_count();
+  out.carried_voxels = out.gas_voxels = out.kept_voxels = 0;
+  // Outputs of another size are released and allocated anew: their hundreds of MB are faulted in on a
+  // thread of their own while the tetrahedra are prepared, each waiting on memory, not on the other. Every voxel is written below (its outcome reset tile by
+  // tile), so outputs of this size are reused as they are.
+  const std::size_t n_out = std::size_t(box.voxel_count());
+  const std::size_t n_labels = src.labels ? n_out : 0;
+  const bool allocating = out.ct_hu.size() != n_out || out.labels.size() != n_labels || out.outcome.size() != n_out;
   std::exception_ptr allocate_failed;   // bad_alloc, rethrown here after the join
-  std::thread allocate([&] {
-    try {
-      out.ct_hu.resize(std::size_t(n_out));
-      if (src.labels) out.labels.resize(std::size_t(n_out));
-      out.outcome.resize(std::size_t(n_out), WarpOutcome::Kept);
-    } catch (...) {
-      allocate_failed = std::current_exception();
-    }
-  });
+  std::thread allocate;
+  if (allocating) {
+    out.ct_hu = {}, out.labels = {}, out.outcome = {};
+    allocate = std::thread([&] {
+      try {
+        out.ct_hu.resize(n_out);
+        out.labels.resize(n_labels);
+        out.outcome.resize(n_out);
+      } catch (...) {
+        allocate_failed = std::current_exception();
+      }
+    });
+  }
   struct JoinOnExit {   // also when preparing throws: a joinable thread's destructor would terminate
     std::thread& t;
     ~JoinOnExit() {
@@ -339,11 +356,12 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
   } join_allocate{allocate};
   const CubeOrder order = cube_order(mesh);
   timer.lap("order");
-  const std::unique_ptr<RefTet[]> tets(new RefTet[std::size_t(T)]);   // in cube order
+  static_assert(std::is_trivially_destructible_v<RefTet> && alignof(RefTet) <= 64);
+  RefTet* const tets = static_cast<RefTet*>(scratch.reserve(std::size_t(T) * sizeof(RefTet)));   // in cube order
 #pragma omp parallel for schedule(static)
-  for (int64_t n = 0; n < T; ++n) tets[std::size_t(n)] = prepare(mesh, order.tets[std::size_t(n)], box);
+  for (int64_t n = 0; n < T; ++n) new (&tets[n]) RefTet(prepare(mesh, order.tets[std::size_t(n)], box));
   timer.lap("tetrahedra");
-  const std::vector<TetGroup> groups = group_tetrahedra(order, tets.get());
+  const std::vector<TetGroup> groups = group_tetrahedra(order, tets);
   timer.lap("groups");
 
   Index3 tiles;
@@ -360,7 +378,7 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
   }
 
   timer.lap("tiles");
-  allocate.join();
+  if (allocate.joinable()) allocate.join();
   if (allocate_failed) std::rethrow_exception(allocate_failed);
   const SourceGrid grid{mesh.grid.dims, src.ct_hu, src.labels, src.roles};
 
@@ -396,6 +414,8 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
       const int64_t tw = tile.hi[0] - tile.lo[0] + 1, th = tile.hi[1] - tile.lo[1] + 1;
       const int64_t tile_voxels = tw * th * (tile.hi[2] - tile.lo[2] + 1);
       std::fill_n(owner.begin(), tile_voxels, kNoOwner);
+      for (int64_t k = tile.lo[2]; k <= tile.hi[2]; ++k)
+        for (int64_t j = tile.lo[1]; j <= tile.hi[1]; ++j) std::fill_n(outcome + out_index(tile.lo[0], j, k), tw, WarpOutcome::Kept);
       int64_t tile_carried = 0;
       // 1. Scatter and sample, group by group over the box their bounding boxes share with this tile.
       // A tetrahedron's weights w and source point P′ − (d₀ + D w) are affine in the voxel index, so
@@ -473,7 +493,6 @@ WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& 
   out.gas_voxels = gas;
   out.kept_voxels = kept;
   timer.lap("scatter and sample");
-  return out;
 }
 
 }  // namespace pneumo
