@@ -5,8 +5,8 @@
 // source it reads stay in a core's L2 cache (a voxel's trilinear stencil and role lookup are
 // gathers). One thread owns a tile at a time. Where tetrahedra are small the rows through them are
 // short (2.5 voxels on average for 8-voxel cubes), and a row's set-up costs as much as its voxels:
-// so the tetrahedra of one rest cube go together, one pass along each row through the cube serving
-// all five, each voxel going to the lowest-indexed of them that holds it. Across groups (shared
+// so the tetrahedra of one rest cube go together, their spans along each row through the cube found
+// at once (lane by lane in SSE2), each voxel going to the lowest-indexed of them that holds it. Across groups (shared
 // faces, meshes pressed into each other) a per-voxel owner index keeps "the lowest accepting index
 // wins" independent of the order groups come in, whatever the thread count; the winner samples the
 // CT and labels at its source point there and then.
@@ -199,41 +199,26 @@ struct RowLanes {
   alignas(16) int32_t last[kMaxGroup];
   int32_t index[kMaxGroup];
   double src[3][kMaxGroup], step[3][kMaxGroup];
-
-  /// The lanes covering offset t, one bit each, lane 0 lowest.
-  unsigned covering(int32_t t) const {
-#if defined(__SSE2__)
-    static_assert(kMaxGroup == 8, "two SSE2 vectors of lanes");
-    const __m128i at = _mm_set1_epi32(t);
-    auto outside = [&](int from) {   // lanes from .. from + 3 with first > t or t > last
-      const __m128i f = _mm_load_si128(reinterpret_cast<const __m128i*>(first + from));
-      const __m128i l = _mm_load_si128(reinterpret_cast<const __m128i*>(last + from));
-      return unsigned(_mm_movemask_ps(_mm_castsi128_ps(_mm_or_si128(_mm_cmpgt_epi32(f, at), _mm_cmpgt_epi32(at, l)))));
-    };
-    return ~(outside(0) | outside(4) << 4) & 0xFFu;
-#else
-    unsigned m = 0;
-    for (int g = 0; g < kMaxGroup; ++g) m |= unsigned(first[g] <= t && t <= last[g]) << g;
-    return m;
-#endif
-  }
 };
 
-/// Offsets t_lo .. t_hi of one row through a group of `part`: each voxel goes to the lowest-indexed
-/// lane covering it whose source role accepts, unless its owner is lower still. `row` and `owner`
-/// are the row's origin in the output and in the tile's owners. Interior: every lane's source points
-/// lie inside the grid, so none needs a bounds check. Returns how many voxels it carried first.
+/// One row through a group of `part`: each voxel goes to the lowest-indexed lane covering it whose
+/// source role accepts, unless its owner is lower still. Lane by lane in ascending index, each a tight
+/// loop over its own span: a voxel a lower lane took is passed over by the owner comparison, one a
+/// lower lane refused (gas so far) is still open to the next. `row` and `owner` are the row's origin
+/// in the output and in the tile's owners. Interior: every lane's source points lie inside the grid,
+/// so none needs a bounds check. Returns how many voxels it carried first.
 template <bool Interior>
-int64_t scatter_row(const RowLanes& lanes, int32_t t_lo, int32_t t_hi, Part part, const SourceGrid& grid,
-                    std::size_t row, int32_t* owner, const ScatterOutput& out) {
+int64_t scatter_row(const RowLanes& lanes, Part part, const SourceGrid& grid, std::size_t row, int32_t* owner,
+                    const ScatterOutput& out) {
   int64_t carried = 0;
-  for (int32_t t = t_lo; t <= t_hi; ++t) {
-    const std::size_t n = row + std::size_t(t);
-    for (unsigned mask = lanes.covering(t); mask; mask &= mask - 1) {
-      const int g = __builtin_ctz(mask);
-      if (lanes.index[g] > owner[t]) break;   // a lower index took it (the lanes ascend)
-      const Vec3 from(lanes.src[0][g] + double(t) * lanes.step[0][g], lanes.src[1][g] + double(t) * lanes.step[1][g],
-                      lanes.src[2][g] + double(t) * lanes.step[2][g]);
+  for (int g = 0; g < kMaxGroup; ++g) {
+    const int32_t index = lanes.index[g];
+    const double src[3] = {lanes.src[0][g], lanes.src[1][g], lanes.src[2][g]};
+    const double step[3] = {lanes.step[0][g], lanes.step[1][g], lanes.step[2][g]};
+    for (int32_t t = lanes.first[g], last = lanes.last[g]; t <= last; ++t) {
+      if (owner[t] < index) continue;   // a lower index took it
+      const std::size_t n = row + std::size_t(t);
+      const Vec3 from(src[0] + double(t) * step[0], src[1] + double(t) * step[1], src[2] + double(t) * step[2]);
       const int64_t v = Interior ? grid.nearest_interior(from) : grid.nearest(from);
       const Role role = v < 0 ? Role::Other : grid.roles[v];
       if (part == Part::Wall ? role == Role::Viscera : role == Role::Wall) {
@@ -241,76 +226,138 @@ int64_t scatter_row(const RowLanes& lanes, int32_t t_lo, int32_t t_hi, Part part
         continue;
       }
       carried += owner[t] == kNoOwner;
-      owner[t] = lanes.index[g];
+      owner[t] = index;
       out.outcome[n] = WarpOutcome::Carried;
       if (Interior) out.hu[n] = float(grid.ct_trilinear_interior(from));
       else out.hu[n] = v < 0 ? float(SourceGrid::kOutsideHu) : float(grid.ct_trilinear_inside(from));
       if (out.label) out.label[n] = v < 0 ? uint16_t(0) : grid.labels[v];
-      break;
     }
   }
   return carried;
 }
 
-/// Where a row (j, k) of the box a group is scattered over in a tile crosses one of its tetrahedra.
+/// Where the rows (j, k) of the box a group is scattered over in a tile cross its tetrahedra, all
+/// lanes at once (laid out lane-innermost, so each step is one vector operation over the lanes).
 /// Along a row each barycentric weight is affine in the offset t from the box's corner,
 /// w_c = w_c(row) + t·step_c, so "every weight ≥ −tolerance" is an interval of t: the containment
 /// test solved for the row at once instead of evaluated voxel by voxel. Its bounds
-/// (−tolerance − w_c(row)) / step_c are themselves affine in the row's offsets (dj, dk), so each
-/// is bound[c] + dj·bound_j[c] + dk·bound_k[c]: a lower bound where step_c > 0, an upper one where
-/// step_c < 0. (This differs from testing voxel by voxel only for a voxel whose weight lies within
-/// rounding, 1e-15 relative, of −tolerance: a tie by any reckoning.) The other side's slot holds a
-/// bound that never binds, so a row's span takes no branches. A weight constant along i (step_c = 0,
-/// faces parallel to i) either holds along the whole row or fails it: its (−tolerance − w_c(row)),
-/// scaled by 2^900 (exactly, so its sign is kept), sits among the lower bounds, where any positive
-/// value empties the row and any other does nothing.
-struct LaneStart {
-  double lower[3][4], upper[3][4];   // [0]: at the corner, [1]: per row along j, [2]: along k
-  Vec3 src, src_i, src_j, src_k;     // source point at the corner, per voxel along i, per row along j and k
-};
-
+/// (−tolerance − w_c(row)) / step_c are themselves affine in the row's offsets (dj, dk): a lower bound
+/// where step_c > 0, an upper one where step_c < 0. (This differs from testing voxel by voxel only
+/// for a voxel whose weight lies within rounding, 1e-15 relative, of −tolerance: a tie by any
+/// reckoning.) The other side's slot holds a bound that never binds, so a row's span takes no
+/// branches. A weight constant along i (step_c = 0, faces parallel to i) either holds along the
+/// whole row or fails it: its (−tolerance − w_c(row)), scaled by 2^900 (exactly, so its sign is
+/// kept), sits among the lower bounds, where any positive value empties the row and any other does
+/// nothing. Each plane k adds its part once (plane()); each row then adds dj times the j part (row()).
 constexpr double kNeverBinds = 1e300;
 constexpr double kConstantScale = 0x1p900;
 
-/// A lane that covers no row: a skipped tetrahedron among its group's.
-LaneStart empty_lane() {
-  LaneStart s{};
-  for (int c = 0; c < 4; ++c) s.lower[0][c] = s.upper[0][c] = kNeverBinds;
-  return s;
-}
+/// The lanes past a group's last tetrahedron.
+const RefTet kEmptyLane = [] {
+  RefTet r{};
+  r.skip = true;
+  return r;
+}();
 
-LaneStart lane_start(const RefTet& r, const Vec3& corner) {
-  if (r.skip) return empty_lane();
-  LaneStart s;
-  const Vec3 w = r.e_inv * (corner - r.x0);
-  const double w_at[4] = {1.0 - w.sum(), w[0], w[1], w[2]};
-  const double w_j[4] = {-r.e_inv.col(1).sum(), r.e_inv(0, 1), r.e_inv(1, 1), r.e_inv(2, 1)};
-  const double w_k[4] = {-r.e_inv.col(2).sum(), r.e_inv(0, 2), r.e_inv(1, 2), r.e_inv(2, 2)};
-  for (int c = 0; c < 4; ++c) {
-    const double at = -kWarpTolerance - w_at[c];
-    double(*bound)[4] = r.w_step[c] < 0 ? s.upper : s.lower;
-    double(*other)[4] = r.w_step[c] < 0 ? s.lower : s.upper;
-    const double scale = r.w_step[c] == 0 ? kConstantScale : r.w_step_inv[c];
-    bound[0][c] = at * scale, bound[1][c] = -w_j[c] * scale, bound[2][c] = -w_k[c] * scale;
-    other[0][c] = r.w_step[c] < 0 ? -kNeverBinds : kNeverBinds, other[1][c] = 0.0, other[2][c] = 0.0;
-  }
-  s.src = corner - (r.d0 + r.dd * w);
-  s.src_i = Vec3::Unit(0) - r.dd * r.e_inv.col(0);
-  s.src_j = Vec3::Unit(1) - r.dd * r.e_inv.col(1);
-  s.src_k = Vec3::Unit(2) - r.dd * r.e_inv.col(2);
-  return s;
-}
+struct GroupSpans {
+  // [0]: at the box's corner, [1]: per row along j, [2]: per plane along k; then weight c, then lane.
+  alignas(64) double lower[3][4][kMaxGroup];
+  alignas(64) double upper[3][4][kMaxGroup];
+  alignas(64) double src[3][3][kMaxGroup];   // source point: [0] at the corner, [1] per row, [2] per plane; axis; lane
+  // The current plane's: corner + dk · per plane.
+  alignas(64) double plane_lower[4][kMaxGroup], plane_upper[4][kMaxGroup], plane_src[3][kMaxGroup];
 
-/// The offsets of row (dj, dk) inside the lane, clipped to 0 .. t_max; first > last when none.
-inline std::pair<int32_t, int32_t> row_span(const LaneStart& s, double dj, double dk, int32_t t_max) {
-  double t_lo = 0.0, t_hi = double(t_max);
-  for (int c = 0; c < 4; ++c) {
-    t_lo = std::max(t_lo, s.lower[0][c] + dj * s.lower[1][c] + dk * s.lower[2][c]);
-    t_hi = std::min(t_hi, s.upper[0][c] + dj * s.upper[1][c] + dk * s.upper[2][c]);
+  /// Lane g from tetrahedron r (a skipped one covers no row), with its source step along i into `lanes`.
+  void set_lane(int g, const RefTet& r, const Vec3& corner, RowLanes& lanes) {
+    if (r.skip) {
+      for (int c = 0; c < 4; ++c) {
+        for (int term = 0; term < 3; ++term) lower[term][c][g] = upper[term][c][g] = 0.0;
+        lower[0][c][g] = upper[0][c][g] = kNeverBinds;
+      }
+      for (int term = 0; term < 3; ++term)
+        for (int a = 0; a < 3; ++a) src[term][a][g] = 0.0;
+      for (int a = 0; a < 3; ++a) lanes.step[a][g] = 0.0;
+      return;
+    }
+    const Vec3 w = r.e_inv * (corner - r.x0);
+    const double w_at[4] = {1.0 - w.sum(), w[0], w[1], w[2]};
+    const double w_j[4] = {-r.e_inv.col(1).sum(), r.e_inv(0, 1), r.e_inv(1, 1), r.e_inv(2, 1)};
+    const double w_k[4] = {-r.e_inv.col(2).sum(), r.e_inv(0, 2), r.e_inv(1, 2), r.e_inv(2, 2)};
+    for (int c = 0; c < 4; ++c) {
+      const double at = -kWarpTolerance - w_at[c];
+      const double step = r.w_step[c];
+      double(*bound)[4][kMaxGroup] = step < 0 ? upper : lower;
+      double(*other)[4][kMaxGroup] = step < 0 ? lower : upper;
+      const double scale = step == 0 ? kConstantScale : r.w_step_inv[c];
+      bound[0][c][g] = at * scale, bound[1][c][g] = -w_j[c] * scale, bound[2][c][g] = -w_k[c] * scale;
+      other[0][c][g] = step < 0 ? -kNeverBinds : kNeverBinds, other[1][c][g] = 0.0, other[2][c][g] = 0.0;
+    }
+    const Vec3 at = corner - (r.d0 + r.dd * w);
+    const Vec3 per_i = Vec3::Unit(0) - r.dd * r.e_inv.col(0);
+    const Vec3 per_j = Vec3::Unit(1) - r.dd * r.e_inv.col(1);
+    const Vec3 per_k = Vec3::Unit(2) - r.dd * r.e_inv.col(2);
+    for (int a = 0; a < 3; ++a) src[0][a][g] = at[a], src[1][a][g] = per_j[a], src[2][a][g] = per_k[a];
+    for (int a = 0; a < 3; ++a) lanes.step[a][g] = per_i[a];
   }
-  if (!(t_lo <= t_hi)) return {1, 0};
-  return {int32_t(ceil_to_int(t_lo)), int32_t(floor_to_int(t_hi))};
-}
+
+  void plane(double dk) {
+    for (int c = 0; c < 4; ++c)
+      for (int g = 0; g < kMaxGroup; ++g) {
+        plane_lower[c][g] = lower[0][c][g] + dk * lower[2][c][g];
+        plane_upper[c][g] = upper[0][c][g] + dk * upper[2][c][g];
+      }
+    for (int a = 0; a < 3; ++a)
+      for (int g = 0; g < kMaxGroup; ++g) plane_src[a][g] = src[0][a][g] + dk * src[2][a][g];
+  }
+
+  /// Row dj of the current plane: each lane's offsets clipped to 0 .. t_max (first > last where it
+  /// covers none) and its source point at offset 0, into `lanes`. Returns the offsets some lane
+  /// covers, first > last when none.
+  std::pair<int32_t, int32_t> row(double dj, int32_t t_max, RowLanes& lanes) const {
+    // Each lane's span lo .. hi, clipped to −1 .. t_max + 1 so that its truncations stay in int32 and
+    // are floor (hi) and, one comparison on, ceil (lo). NaN bounds (none expected: degenerate
+    // tetrahedra are skipped) empty the lane.
+#if defined(__SSE2__)
+    static_assert(kMaxGroup % 2 == 0, "lanes in SSE2 pairs");
+    const __m128d at_j = _mm_set1_pd(dj), t_end = _mm_set1_pd(double(t_max)), past_end = _mm_set1_pd(double(t_max) + 1.0),
+                  before = _mm_set1_pd(-1.0);
+    for (int g = 0; g < kMaxGroup; g += 2) {
+      __m128d lo = _mm_setzero_pd(), hi = t_end;
+      for (int c = 0; c < 4; ++c) {
+        lo = _mm_max_pd(lo, _mm_add_pd(_mm_load_pd(plane_lower[c] + g), _mm_mul_pd(at_j, _mm_load_pd(lower[1][c] + g))));
+        hi = _mm_min_pd(hi, _mm_add_pd(_mm_load_pd(plane_upper[c] + g), _mm_mul_pd(at_j, _mm_load_pd(upper[1][c] + g))));
+      }
+      lo = _mm_min_pd(lo, past_end), hi = _mm_max_pd(hi, before);
+      const __m128i lt = _mm_cvttpd_epi32(lo), ht = _mm_cvttpd_epi32(hi);   // two int32 in the low half
+      // The comparisons' 64-bit masks (all ones: −1) packed to two int32 beside the truncations.
+      auto low_pair = [](__m128d mask) { return _mm_shuffle_epi32(_mm_castpd_si128(mask), _MM_SHUFFLE(2, 0, 2, 0)); };
+      const __m128i first = _mm_sub_epi32(lt, low_pair(_mm_cmplt_pd(_mm_cvtepi32_pd(lt), lo)));
+      const __m128i last = _mm_add_epi32(ht, low_pair(_mm_cmpgt_pd(_mm_cvtepi32_pd(ht), hi)));
+      _mm_storel_epi64(reinterpret_cast<__m128i*>(lanes.first + g), first);
+      _mm_storel_epi64(reinterpret_cast<__m128i*>(lanes.last + g), last);
+    }
+#else
+    for (int g = 0; g < kMaxGroup; ++g) {
+      double lo = 0.0, hi = double(t_max);
+      for (int c = 0; c < 4; ++c) {
+        lo = std::max(lo, plane_lower[c][g] + dj * lower[1][c][g]);
+        hi = std::min(hi, plane_upper[c][g] + dj * upper[1][c][g]);
+      }
+      if (!(lo <= hi)) lo = double(t_max) + 1.0, hi = -1.0;
+      lo = std::min(lo, double(t_max) + 1.0), hi = std::max(hi, -1.0);
+      lanes.first[g] = int32_t(ceil_to_int(lo)), lanes.last[g] = int32_t(floor_to_int(hi));
+    }
+#endif
+    int32_t first_all = INT32_MAX, last_all = INT32_MIN;
+    for (int g = 0; g < kMaxGroup; ++g) {
+      first_all = std::min(first_all, lanes.first[g]);
+      last_all = std::max(last_all, lanes.first[g] <= lanes.last[g] ? lanes.last[g] : INT32_MIN);
+    }
+    for (int a = 0; a < 3; ++a)
+      for (int g = 0; g < kMaxGroup; ++g) lanes.src[a][g] = plane_src[a][g] + dj * src[1][a][g];
+    return {first_all, last_all};
+  }
+};
 
 }  // namespace
 
@@ -402,7 +449,7 @@ void warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, c
   {
     std::vector<int32_t> owner(std::size_t(kTile[0] * kTile[1] * kTile[2]));
     RowLanes lanes;
-    LaneStart start[kMaxGroup];
+    GroupSpans spans;
 #pragma omp for schedule(dynamic, 1)
     for (int64_t n_tile = 0; n_tile < n_tiles; ++n_tile) {
       Tile tile;
@@ -428,34 +475,23 @@ void warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, c
         Index3 lo, hi;
         for (int a = 0; a < 3; ++a) lo[a] = std::max(group.lo[a], tile.lo[a]), hi[a] = std::min(group.hi[a], tile.hi[a]);
         const Vec3 corner(static_cast<double>(lo[0]), static_cast<double>(lo[1]), static_cast<double>(lo[2]));
-        for (int g = 0; g < kMaxGroup; ++g) lanes.first[g] = 1, lanes.last[g] = 0;
-        for (int g = 0; g < group.count; ++g) {
-          const RefTet& r = tets[std::size_t(group.first + g)];
-          const int32_t t = order.tets[std::size_t(group.first + g)];
-          start[g] = lane_start(r, corner);
-          for (int a = 0; a < 3; ++a) lanes.step[a][g] = start[g].src_i[a];
-          lanes.index[g] = t;
+        for (int g = 0; g < kMaxGroup; ++g) {
+          const bool in_group = g < group.count;
+          spans.set_lane(g, in_group ? tets[std::size_t(group.first + g)] : kEmptyLane, corner, lanes);
+          lanes.index[g] = in_group ? order.tets[std::size_t(group.first + g)] : INT32_MAX;
         }
         const int32_t t_max = int32_t(hi[0] - lo[0]);
-        for (int64_t k = lo[2]; k <= hi[2]; ++k)
+        for (int64_t k = lo[2]; k <= hi[2]; ++k) {
+          spans.plane(double(k - lo[2]));
           for (int64_t j = lo[1]; j <= hi[1]; ++j) {
-            const double dj = double(j - lo[1]), dk = double(k - lo[2]);
-            int32_t t_lo = INT32_MAX, t_hi = INT32_MIN;
-            for (int g = 0; g < group.count; ++g) {
-              const LaneStart& s = start[g];
-              const auto [first, last] = row_span(s, dj, dk, t_max);
-              lanes.first[g] = first, lanes.last[g] = last;
-              if (first > last) continue;
-              t_lo = std::min(t_lo, first), t_hi = std::max(t_hi, last);
-              const Vec3 src_row = s.src + dj * s.src_j + dk * s.src_k;
-              for (int a = 0; a < 3; ++a) lanes.src[a][g] = src_row[a];
-            }
+            const auto [t_lo, t_hi] = spans.row(double(j - lo[1]), t_max, lanes);
             if (t_lo > t_hi) continue;
             const std::size_t row = out_index(lo[0], j, k);
             int32_t* const own = owner.data() + (lo[0] - tile.lo[0]) + tw * ((j - tile.lo[1]) + th * (k - tile.lo[2]));
-            tile_carried += group.interior ? scatter_row<true>(lanes, t_lo, t_hi, group.part, grid, row, own, state)
-                                           : scatter_row<false>(lanes, t_lo, t_hi, group.part, grid, row, own, state);
+            tile_carried += group.interior ? scatter_row<true>(lanes, group.part, grid, row, own, state)
+                                           : scatter_row<false>(lanes, group.part, grid, row, own, state);
           }
+        }
       }
       // 2. What no tetrahedron took: gas inside the meshes' space before or after deformation,
       // otherwise the voxel's own value. Nothing to do in a tile carried whole.
