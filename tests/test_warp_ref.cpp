@@ -216,6 +216,7 @@ TEST_F(WarpRef, ASeriesOfWarpsGivesWhatFreshWarpsGive) {
     EXPECT_EQ(again.kept_voxels, fresh.kept_voxels);
     EXPECT_EQ(again.labels.empty(), s.src.labels == nullptr);
   }
+  EXPECT_EQ(series.result().labels.capacity(), 0u) << "labels switched off, their memory still held";
   EXPECT_GT(warp_ref(lift, c.source(), c.whole(), options()).gas_voxels, 0);
 }
 

@@ -88,7 +88,7 @@ WarpResult warp_on_device(const std::string& device, const WarpMesh& mesh, const
 /// ITK's filters keep their output buffer between updates. (OpenCL warps allocate their own host outputs.)
 class WarpSeries {
  public:
-  /// warp_on_device; the result is valid until the next warp.
+  /// warp_on_device; the result is valid until the next warp. After a throw the series holds none.
   const WarpResult& warp(const std::string& device, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,
                          const WarpOptions& opt);
   /// The last warp's result.

@@ -171,10 +171,15 @@ WarpResult warp_on_device(const std::string& device, const WarpMesh& mesh, const
 
 const WarpResult& WarpSeries::warp(const std::string& device, const WarpMesh& mesh, const WarpSource& src,
                                    const WarpBox& box, const WarpOptions& opt) {
-  if (ocl::parse_device_spec(device).use_opencl) {
-    result_ = WarpResult{};   // the last outputs go before the next are allocated
-    result_ = warp_on_device(device, mesh, src, box, opt);
-  } else warp_ref(mesh, src, box, opt, result_, scratch_);
+  try {
+    if (ocl::parse_device_spec(device).use_opencl) {
+      result_ = WarpResult{};   // the last outputs go before the next are allocated
+      result_ = warp_on_device(device, mesh, src, box, opt);
+    } else warp_ref(mesh, src, box, opt, result_, scratch_);
+  } catch (...) {
+    result_ = WarpResult{};   // no half-written result that looks like one
+    throw;
+  }
   return result_;
 }
 

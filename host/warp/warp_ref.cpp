@@ -315,8 +315,10 @@ struct GroupSpans {
   /// covers, first > last when none.
   std::pair<int32_t, int32_t> row(double dj, int32_t t_max, RowLanes& lanes) const {
     // Each lane's span lo .. hi, clipped to −1 .. t_max + 1 so that its truncations stay in int32 and
-    // are floor (hi) and, one comparison on, ceil (lo). NaN bounds (none expected: degenerate
-    // tetrahedra are skipped) empty the lane.
+    // are floor (hi) and, one comparison on, ceil (lo). A NaN bound (none expected: degenerate
+    // tetrahedra are skipped) is passed over, as std::max and std::min pass over their second
+    // argument's NaN (MAXPD and MINPD return their second operand where either is NaN), so every
+    // span stays inside the row.
 #if defined(__SSE2__)
     static_assert(kMaxGroup % 2 == 0, "lanes in SSE2 pairs");
     const __m128d at_j = _mm_set1_pd(dj), t_end = _mm_set1_pd(double(t_max)), past_end = _mm_set1_pd(double(t_max) + 1.0),
@@ -324,8 +326,8 @@ struct GroupSpans {
     for (int g = 0; g < kMaxGroup; g += 2) {
       __m128d lo = _mm_setzero_pd(), hi = t_end;
       for (int c = 0; c < 4; ++c) {
-        lo = _mm_max_pd(lo, _mm_add_pd(_mm_load_pd(plane_lower[c] + g), _mm_mul_pd(at_j, _mm_load_pd(lower[1][c] + g))));
-        hi = _mm_min_pd(hi, _mm_add_pd(_mm_load_pd(plane_upper[c] + g), _mm_mul_pd(at_j, _mm_load_pd(upper[1][c] + g))));
+        lo = _mm_max_pd(_mm_add_pd(_mm_load_pd(plane_lower[c] + g), _mm_mul_pd(at_j, _mm_load_pd(lower[1][c] + g))), lo);
+        hi = _mm_min_pd(_mm_add_pd(_mm_load_pd(plane_upper[c] + g), _mm_mul_pd(at_j, _mm_load_pd(upper[1][c] + g))), hi);
       }
       lo = _mm_min_pd(lo, past_end), hi = _mm_max_pd(hi, before);
       const __m128i lt = _mm_cvttpd_epi32(lo), ht = _mm_cvttpd_epi32(hi);   // two int32 in the low half
@@ -343,7 +345,6 @@ struct GroupSpans {
         lo = std::max(lo, plane_lower[c][g] + dj * lower[1][c][g]);
         hi = std::min(hi, plane_upper[c][g] + dj * upper[1][c][g]);
       }
-      if (!(lo <= hi)) lo = double(t_max) + 1.0, hi = -1.0;
       lo = std::min(lo, double(t_max) + 1.0), hi = std::max(hi, -1.0);
       lanes.first[g] = int32_t(ceil_to_int(lo)), lanes.last[g] = int32_t(floor_to_int(hi));
     }
@@ -384,7 +385,10 @@ void warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, c
   std::exception_ptr allocate_failed;   // bad_alloc, rethrown here after the join
   std::thread allocate;
   if (allocating) {
-    out.ct_hu = {}, out.labels = {}, out.outcome = {};
+    // Released before the new ones are allocated (assigning {} would keep the capacity).
+    std::vector<float>().swap(out.ct_hu);
+    std::vector<uint16_t>().swap(out.labels);
+    std::vector<WarpOutcome>().swap(out.outcome);
     allocate = std::thread([&] {
       try {
         out.ct_hu.resize(n_out);
