@@ -74,7 +74,7 @@ RefTet prepare(const WarpMesh& m, int64_t t, const WarpBox& box) {
   r.part = m.tet_part[std::size_t(t)];
   r.w_step[0] = -r.e_inv.col(0).sum();
   for (int c = 0; c < 3; ++c) r.w_step[1 + c] = r.e_inv(c, 0);
-  for (int c = 0; c < 4; ++c) r.w_step_inv[c] = 1.0 / r.w_step[c];   // ±inf for 0: lane_start looks at the sign first
+  for (int c = 0; c < 4; ++c) r.w_step_inv[c] = 1.0 / r.w_step[c];   // ±inf for 0: GroupSpans::set_lane looks at the sign first
   r.skip = false;
   for (int a = 0; a < 3; ++a) {
     double lo = x[0][a], hi = x[0][a];
