@@ -26,7 +26,6 @@ class ReusableBuffer {
     }
     return memory_.get();
   }
-  std::size_t capacity() const { return bytes_; }
 
  private:
   struct Free {

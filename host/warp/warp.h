@@ -65,7 +65,7 @@ struct WarpResult {
 /// The CPU reference. Deterministic for any thread count. Shows Progress("warp").
 WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt);
 /// The same into `out`, reusing its outputs' memory where they already have the box's size, and
-/// `scratch` for the prepared tetrahedra (~300 bytes each): what a series of warps keeps (WarpSeries).
+/// `scratch` for the prepared tetrahedra (256 bytes each): what a series of warps keeps (WarpSeries).
 void warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt,
               WarpResult& out, ReusableBuffer& scratch);
 
@@ -83,8 +83,8 @@ WarpResult warp_on_device(const std::string& device, const WarpMesh& mesh, const
 
 /// Warps one after another into memory kept between them: a time-lapse's frames, a benchmark's
 /// repetitions. The CPU warp of the peers' 512×512×300 case writes 400 MB of outputs and prepares
-/// 240 MB of tetrahedra; faulting that in anew costs 0.3 s or more per warp on the VMs here (seconds
-/// where the host has taken the pages back), a quarter of the warp, so a series faults it in once, as
+/// 200 MB of tetrahedra; faulting that in anew costs 0.3 s or more per warp on the VMs here (seconds
+/// where the host has taken the pages back), a third of the warp or more, so a series faults it in once, as
 /// ITK's filters keep their output buffer between updates. (OpenCL warps allocate their own host outputs.)
 class WarpSeries {
  public:

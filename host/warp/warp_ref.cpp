@@ -6,10 +6,10 @@
 // gathers). One thread owns a tile at a time. Where tetrahedra are small the rows through them are
 // short (2.5 voxels on average for 8-voxel cubes), and a row's set-up costs as much as its voxels:
 // so the tetrahedra of one rest cube go together, their spans along each row through the cube found
-// at once (lane by lane in SSE2), each voxel going to the lowest-indexed of them that holds it. Across groups (shared
-// faces, meshes pressed into each other) a per-voxel owner index keeps "the lowest accepting index
-// wins" independent of the order groups come in, whatever the thread count; the winner samples the
-// CT and labels at its source point there and then.
+// at once (in SSE2, lanes side by side), each voxel going to the lowest-indexed of them that holds
+// it. Across groups (shared faces, meshes pressed into each other) a per-voxel owner index keeps
+// "the lowest accepting index wins" independent of the order groups come in, whatever the thread
+// count; the winner samples the CT and labels at its source point there and then.
 #include <omp.h>
 
 #include <algorithm>
@@ -37,7 +37,7 @@ namespace {
 constexpr Index3 kTile{256, 8, 8};
 
 /// One deformed tetrahedron, ready for containment tests. No default member values: the table of them
-/// (~300 bytes a tetrahedron) is allocated uninitialised and filled in parallel by prepare(), which
+/// (256 bytes a tetrahedron) is allocated uninitialised and filled in parallel by prepare(), which
 /// sets every field, rather than zeroed first on one thread.
 struct RefTet {
   bool skip;                        // degenerate (warp_tet_degenerate), or its box misses the output
@@ -45,7 +45,6 @@ struct RefTet {
   Mat3 e_inv;                       // inverse of [x1−x0, x2−x0, x3−x0]
   Vec3 d0;                          // displacement of vertex 0
   Mat3 dd;                          // [d1−d0, d2−d0, d3−d0]
-  double w_step[4], w_step_inv[4];  // each weight's change per voxel along i, and its inverse (row spans)
   Index3 lo, hi;                    // voxel centres of the bounding box (box-clipped, inclusive)
   Part part;
   // Every source point it maps lies inside the grid, a whole voxel clear of the far faces: its voxels
@@ -72,9 +71,6 @@ RefTet prepare(const WarpMesh& m, int64_t t, const WarpBox& box) {
   r.d0 = m.disp_ijk[v[0]];
   r.dd << m.disp_ijk[v[1]] - r.d0, m.disp_ijk[v[2]] - r.d0, m.disp_ijk[v[3]] - r.d0;
   r.part = m.tet_part[std::size_t(t)];
-  r.w_step[0] = -r.e_inv.col(0).sum();
-  for (int c = 0; c < 3; ++c) r.w_step[1 + c] = r.e_inv(c, 0);
-  for (int c = 0; c < 4; ++c) r.w_step_inv[c] = 1.0 / r.w_step[c];   // ±inf for 0: GroupSpans::set_lane looks at the sign first
   r.skip = false;
   for (int a = 0; a < 3; ++a) {
     double lo = x[0][a], hi = x[0][a];
@@ -281,14 +277,15 @@ struct GroupSpans {
     }
     const Vec3 w = r.e_inv * (corner - r.x0);
     const double w_at[4] = {1.0 - w.sum(), w[0], w[1], w[2]};
+    const double w_i[4] = {-r.e_inv.col(0).sum(), r.e_inv(0, 0), r.e_inv(1, 0), r.e_inv(2, 0)};
     const double w_j[4] = {-r.e_inv.col(1).sum(), r.e_inv(0, 1), r.e_inv(1, 1), r.e_inv(2, 1)};
     const double w_k[4] = {-r.e_inv.col(2).sum(), r.e_inv(0, 2), r.e_inv(1, 2), r.e_inv(2, 2)};
     for (int c = 0; c < 4; ++c) {
       const double at = -kWarpTolerance - w_at[c];
-      const double step = r.w_step[c];
+      const double step = w_i[c];
       double(*bound)[4][kMaxGroup] = step < 0 ? upper : lower;
       double(*other)[4][kMaxGroup] = step < 0 ? lower : upper;
-      const double scale = step == 0 ? kConstantScale : r.w_step_inv[c];
+      const double scale = step == 0 ? kConstantScale : 1.0 / step;
       bound[0][c][g] = at * scale, bound[1][c][g] = -w_j[c] * scale, bound[2][c][g] = -w_k[c] * scale;
       other[0][c][g] = step < 0 ? -kNeverBinds : kNeverBinds, other[1][c][g] = 0.0, other[2][c][g] = 0.0;
     }
@@ -377,8 +374,9 @@ void warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, c
   out.device = "cpu";
   out.carried_voxels = out.gas_voxels = out.kept_voxels = 0;
   // Outputs of another size are released and allocated anew: their hundreds of MB are faulted in on a
-  // thread of their own while the tetrahedra are prepared, each waiting on memory, not on the other. Every voxel is written below (its outcome reset tile by
-  // tile), so outputs of this size are reused as they are.
+  // thread of their own while the tetrahedra are prepared, each waiting on memory, not on the other.
+  // Every voxel is written below (its outcome reset tile by tile), so outputs of this size are reused
+  // as they are.
   const std::size_t n_out = std::size_t(box.voxel_count());
   const std::size_t n_labels = src.labels ? n_out : 0;
   const bool allocating = out.ct_hu.size() != n_out || out.labels.size() != n_labels || out.outcome.size() != n_out;
