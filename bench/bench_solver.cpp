@@ -98,7 +98,7 @@ const Case kSizes[] = {{PhantomSize::Small, 0, "small"},
 
 struct MeshCase {
   Mesh mesh;
-  ForceModel model;      // the scene's: 12 mmHg on the cavity triangles, volume term off
+  ForceModel model;      // the scene's: 12 mmHg on the cavity faces, volume term off
   double dt_s = 0.0;     // dt_safety × the stability bound, as the explicit solver chooses it
   std::vector<Vec3> x0, v0;   // a perturbed state: nothing trivially zero
 };
@@ -135,10 +135,10 @@ const MeshCase& mesh_case(const Case& size) {
     c->v0[n] = 1e-3 * Vec3(b, s, a);
   }
   const MeshStats& st = c->mesh.stats;
-  std::fprintf(stderr, "[bench_solver] %s mesh: %lld nodes, %lld springs, %lld tetrahedra, %lld cavity triangles, "
+  std::fprintf(stderr, "[bench_solver] %s mesh: %lld nodes, %lld springs, %lld tetrahedra, %lld pressure tetrahedra, "
                        "dt %.3g ms, pressure %.1f Pa (built in %.1f s)\n",
                size.name, (long long)st.nodes, (long long)st.springs, (long long)st.tetrahedra,
-               (long long)st.cavity_triangles, c->dt_s * 1e3, c->model.pressure_pa,
+               (long long)st.pressure_tetrahedra, c->dt_s * 1e3, c->model.pressure_pa,
                std::chrono::duration<double>(Clock::now() - t0).count());
   slot = std::move(c);
   return *slot;

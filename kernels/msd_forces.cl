@@ -43,26 +43,32 @@ typedef int16 intW;
     }                                              \
   } while (0)
 
-// Gas pressure on each cavity triangle: F = −P·S·n/3 per vertex, S·n = ½(x_b − x_a)×(x_c − x_a).
-__kernel void triangle_pressure(__global const float4* restrict u, __global const float4* restrict rest_x,
-                                __global const int4* restrict tris, const float pressure_pa, const int n_tris,
-                                __global float4* restrict tri_force) {
+// Gas pressure on the cavity faces embedded in each loaded tetrahedron (host/mesh/mesh.h):
+// f_i = −P · cof(D_s) · c_i, cof(D_s)·c = c.x (e2×e3) + c.y (e3×e1) + c.z (e1×e2), 4 vertices.
+__kernel void load_pressure(__global const float4* restrict u, __global const float4* restrict rest_x,
+                            __global const int4* restrict load_nodes, __global const float4* restrict load_c,
+                            const float pressure_pa, const int n_loads, __global float4* restrict load_force) {
   const int t = get_global_id(0);
-  if (t >= n_tris) return;
-  const int4 q = tris[t];
-  const float3 ua = u[q.x].xyz, a0 = rest_x[q.x].xyz;
-  const float3 ab = (rest_x[q.y].xyz - a0) + (u[q.y].xyz - ua);
-  const float3 ac = (rest_x[q.z].xyz - a0) + (u[q.z].xyz - ua);
-  const float3 area_normal = 0.5f * cross(ab, ac);
-  tri_force[t] = (float4)(-pressure_pa * area_normal / 3.0f, 0.0f);
+  if (t >= n_loads) return;
+  const int4 q = load_nodes[t];
+  const float3 a0 = rest_x[q.x].xyz, ua = u[q.x].xyz;
+  const float3 e1 = (rest_x[q.y].xyz - a0) + (u[q.y].xyz - ua);
+  const float3 e2 = (rest_x[q.z].xyz - a0) + (u[q.z].xyz - ua);
+  const float3 e3 = (rest_x[q.w].xyz - a0) + (u[q.w].xyz - ua);
+  const float3 k1 = cross(e2, e3), k2 = cross(e3, e1), k3 = cross(e1, e2);
+  _Pragma("unroll") for (int i = 0; i < 4; ++i) {
+    const float3 c = load_c[4 * t + i].xyz;
+    load_force[4 * t + i] = (float4)(-pressure_pa * (c.x * k1 + c.y * k2 + c.z * k3), 0.0f);
+  }
 }
 
-// Kitasaka's volume preservation per tetrahedron: f_i = −k_v ((V − V₀)/V₀) ∂V/∂x_i, 4 vertices.
+// Kitasaka's volume preservation per tetrahedron: f_i = −k_v f_t ((V − V₀)/V₀) ∂V/∂x_i, 4 vertices
+// (f_t: the share of the tetrahedron its tissue fills, host/mesh/mesh.h).
 // The rest volume is recomputed here from the same rounded rest edges, so an undeformed
 // tetrahedron gives exactly zero force.
 __kernel void tet_volume(__global const float4* restrict u, __global const float4* restrict rest_x,
-                         __global const int4* restrict tets, const float volume_stiffness_pa, const int n_tets,
-                         __global float4* restrict tet_force) {
+                         __global const int4* restrict tets, __global const float* restrict tet_fraction,
+                         const float volume_stiffness_pa, const int n_tets, __global float4* restrict tet_force) {
   const int t = get_global_id(0);
   if (t >= n_tets) return;
   const int4 q = tets[t];
@@ -75,7 +81,7 @@ __kernel void tet_volume(__global const float4* restrict u, __global const float
   const float3 g0 = -(g1 + g2 + g3);
   const float v0 = dot(e1r, cross(e2r, e3r)) / 6.0f;
   const float volume = dot(e1, g1);
-  const float s = -volume_stiffness_pa * (volume - v0) / v0;
+  const float s = -volume_stiffness_pa * tet_fraction[t] * (volume - v0) / v0;
   tet_force[4 * t + 0] = (float4)(s * g0, 0.0f);
   tet_force[4 * t + 1] = (float4)(s * g1, 0.0f);
   tet_force[4 * t + 2] = (float4)(s * g2, 0.0f);
@@ -83,9 +89,9 @@ __kernel void tet_volume(__global const float4* restrict u, __global const float
 }
 
 // The net force on each node of a block: its springs and dampers (nonlinear, or Nimura's linear
-// form), plus the triangle and tetrahedron forces computed above, plus gravity.
+// form), plus the pressure-load and tetrahedron forces computed above, plus gravity.
 // block_nodes: W node ids per block (−1 pads the last block). *_begin: per block, its first record
-// (records of block b: begin[b] … begin[b + 1] − 1). Element records index tri_force / tet_force,
+// (records of block b: begin[b] … begin[b + 1] − 1). Element records index load_force / tet_force,
 // whose last entry is a zero the padding points at.
 __kernel void node_forces(__global const float4* restrict u, __global const float4* restrict v,
                           __global const float* restrict mass, const int n_blocks,
@@ -95,8 +101,8 @@ __kernel void node_forces(__global const float4* restrict u, __global const floa
                           __global const float* restrict rest_x, __global const float* restrict rest_y,
                           __global const float* restrict rest_z, __global const float* restrict rest_len,
                           const int linear_springs, const int damping,
-                          __global const float4* restrict tri_force, __global const int* restrict tri_begin,
-                          __global const int* restrict node_tri, const int with_tris,
+                          __global const float4* restrict load_force, __global const int* restrict load_begin,
+                          __global const int* restrict node_load, const int with_loads,
                           __global const float4* restrict tet_force, __global const int* restrict tet_begin,
                           __global const int* restrict node_tet, const int with_tets,
                           const float4 gravity, __global float4* restrict force) {
@@ -143,12 +149,12 @@ __kernel void node_forces(__global const float4* restrict u, __global const floa
       fz += s * ez;
     }
   }
-  if (with_tris) {
-    const int t_end = tri_begin[b + 1];
-    for (int r = tri_begin[b]; r < t_end; ++r) {
-      const intW t = vloadW(r, node_tri);
+  if (with_loads) {
+    const int t_end = load_begin[b + 1];
+    for (int r = load_begin[b]; r < t_end; ++r) {
+      const intW t = vloadW(r, node_load);   // indexes load_force directly: 4·load + vertex
       floatW gx, gy, gz;
-      GATHER3(tri_force, t, gx, gy, gz);
+      GATHER3(load_force, t, gx, gy, gz);
       fx += gx;
       fy += gy;
       fz += gz;

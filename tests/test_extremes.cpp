@@ -310,7 +310,8 @@ TEST(ExtremeMesh, CubesOf2To16VoxelsMeshTheSameBodyAlike) {
     const Mesh m = slab({L});
     ASSERT_EQ(m.node_count(), reference.node_count());
     ASSERT_EQ(m.tets.size(), reference.tets.size());
-    ASSERT_EQ(m.cavity_tris.size(), reference.cavity_tris.size());
+    ASSERT_EQ(m.load_tet.size(), reference.load_tet.size());
+    ASSERT_EQ(m.stats.cavity_faces, reference.stats.cavity_faces * L * L);
     // Nodes sit at voxel-grid corners, half a voxel from the centres: the mesh shifts by (5 − 5/L)/2 mm
     // per axis as a whole, so shapes are compared relative to node 0.
     double worst = 0.0;
@@ -331,9 +332,11 @@ TEST(ExtremeMesh, OneCube) {
   // Compared, on meshes of a single cube (8 nodes, 5 tetrahedra):
   //  - a free wall cube with no load: the static solver answers the rest shape, converged; an explicit run
   //    from a seeded random 1e-3 h perturbation stays finite and bounded (within 2× the perturbation);
-  //  - a wall cube on a viscera voxel (wall-only model: one cube, its underside two cavity triangles),
-  //    nothing fixed: the gas lifts it as a whole; refused as a rigid drift (InputError naming it);
-  //  - a cube holding a fixed voxel: all 8 nodes fixed, nothing can move: refused (InputError).
+  //  - a wall cube on a viscera voxel (wall-only model: one cube, its underside one cavity face carried
+  //    by the two corner tetrahedra under it), nothing fixed: the gas lifts it as a whole; refused as a
+  //    rigid drift (InputError naming it);
+  //  - a cube of 3³ voxels whose 8 corner voxels are fixed: each node touches one, all 8 are fixed,
+  //    nothing can move: refused (InputError).
   const OneThread one;
   Geometry g;
   g.dims = {1, 1, 1};
@@ -368,18 +371,21 @@ TEST(ExtremeMesh, OneCube) {
   Mesh lid = build_mesh(VoxelRoles{g2, on_viscera.data(), nullptr}, wall_only, [](Role, int) { return 60e3; });
   assign_material(lid, MaterialOptions{});
   ASSERT_EQ(lid.node_count(), 8);
-  ASSERT_EQ(lid.cavity_tris.size(), 2u);
+  ASSERT_EQ(lid.stats.cavity_faces, 1);
+  ASSERT_EQ(lid.load_tet.size(), 2u);
   const std::string drift = input_error_of([&] { solve(lid, quiet(SolverMethod::Static, 12.0)); });
   EXPECT_NE(drift.find("attached to no fixed node along z"), std::string::npos) << drift;
   EXPECT_NE(drift.find("drift"), std::string::npos) << drift;
 
   Geometry g3;
-  g3.dims = {2, 2, 2};
-  g3.spacing_mm = Vec3::Constant(kCubeMm / 2);
+  g3.dims = {3, 3, 3};
+  g3.spacing_mm = Vec3::Constant(kCubeMm / 3);
   MeshOptions mo2;
-  mo2.cube_voxels = 2;
-  std::vector<Role> with_fixed(8, Role::Wall);
-  with_fixed[0] = Role::Fixed;
+  mo2.cube_voxels = 3;
+  std::vector<Role> with_fixed(27, Role::Wall);
+  for (int k : {0, 2})
+    for (int j : {0, 2})
+      for (int i : {0, 2}) with_fixed[g3.linear_index(i, j, k)] = Role::Fixed;
   Mesh held = build_mesh(VoxelRoles{g3, with_fixed.data(), nullptr}, mo2, [](Role, int) { return 60e3; });
   assign_material(held, MaterialOptions{});
   const std::string fixed = input_error_of([&] { solve(held, quiet(SolverMethod::Static, 12.0)); });

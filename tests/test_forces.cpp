@@ -80,11 +80,11 @@ Mesh without_springs(const Mesh& m) {
   return q;
 }
 
-/// Volume enclosed by the cavity triangles (divergence theorem: V = Σ x_a·(x_b × x_c)/6), positive when
-/// their normals point out of the enclosed region.
-double enclosed_volume(const Mesh& m, const std::vector<Vec3>& x) {
+/// Volume of the solid: the sum of its tetrahedra's signed volumes. Independent of the pressure loads,
+/// whose faces bound it when the whole surface faces the gas.
+double solid_volume(const Mesh& m, const std::vector<Vec3>& x) {
   double v = 0.0;
-  for (const auto& t : m.cavity_tris) v += x[t[0]].dot(x[t[1]].cross(x[t[2]])) / 6.0;
+  for (const auto& q : m.tets) v += signed_tet_volume(x[q[0]], x[q[1]], x[q[2]], x[q[3]]);
   return v;
 }
 
@@ -191,22 +191,26 @@ TEST(ForcesRigid, DampersVanishUnderRigidVelocity) {
 
 TEST(ForcesPressure, ClosedSurfaceSumsToZeroAndIsMinusPGradVolume) {
   // Compared: gas pressure on the closed cavity surface of a 3×3×3 wall block surrounded by viscera (a
-  // wall-only model, so every boundary face is a cavity triangle), at randomly perturbed positions (±0.1 h,
+  // wall-only model, so every boundary face is a cavity face; L = 1, so each lies on a tetrahedron's face),
+  // at randomly perturbed positions (±0.1 h,
   // seeded), against:
   //  (1) zero net force: Σ_i F_i = −P Σ S n over a closed surface = 0. Tolerance 1e-12·Σ|F_i| (rounding of
   //      the cancelling area vectors);
-  //  (2) −P ∂V/∂x_i by central differences of the volume V of the solid, from the triangles by the divergence
-  //      theorem. The normals point out of the solid and the gas is outside it, so F = −P S n pushes into the
-  //      solid: the force is minus P times the gradient of the solid's volume (the gas does work −P dV on
-  //      the solid). V is affine in each single node's position (each triangle's triple product holds a node
-  //      once), so the central difference is exact and only rounding remains, about ε·V/(δ·h²) ≈ 1e-13 of
-  //      the force for δ = 0.1 h (measured 2.6e-14): tolerance 1e-10 relative to the largest nodal force;
-  //  (3) at rest V equals the block's volume (27 h³; the sign checks the orientation), 1e-12 relative.
+  //  (2) −P ∂V/∂x_i by central differences of the volume V of the solid, the sum of its tetrahedra's
+  //      volumes (not the loads' own formula). The loads' normals point out of the solid and the gas is
+  //      outside it, so F = −P S n pushes into the solid: the force is minus P times the gradient of the
+  //      solid's volume (the gas does work −P dV on the solid). V is affine in each single node's position
+  //      (each tetrahedron holds a node once), so the central difference is exact and only rounding
+  //      remains, about ε·V/(δ·h²) ≈ 1e-13 of the force for δ = 0.1 h: tolerance 1e-10 relative to the
+  //      largest nodal force;
+  //  (3) at rest the gas volume the loads enclose (enclosed_cavity_volume, normals into the gas) is minus
+  //      the block's volume (27 h³; the sign checks the orientation), 1e-12 relative, and it follows the
+  //      solid's volume when the nodes move.
   const Mesh full = enclosed_block(3);
   const Mesh m = without_springs(full);
   const double h = units::mm_to_m(kSpacingMm), P = units::mmhg_to_pa(12.0);
-  ASSERT_EQ(m.cavity_tris.size(), 6u * 9u * 2u);
-  EXPECT_NEAR(enclosed_volume(m, m.rest_m), 27 * h * h * h, 1e-12 * 27 * h * h * h);
+  ASSERT_EQ(m.stats.cavity_faces, 6 * 9);
+  EXPECT_NEAR(enclosed_cavity_volume(m, m.rest_m, Vec3::Zero()), -27 * h * h * h, 1e-12 * 27 * h * h * h);
 
   std::mt19937 rng(kSeed + 1);
   SCOPED_TRACE("seed " + std::to_string(kSeed + 1));
@@ -230,11 +234,12 @@ TEST(ForcesPressure, ClosedSurfaceSumsToZeroAndIsMinusPGradVolume) {
       std::vector<Vec3> xp = x, xm = x;
       xp[i][a] += delta;
       xm[i][a] -= delta;
-      grad[a] = (enclosed_volume(m, xp) - enclosed_volume(m, xm)) / (2 * delta);
+      grad[a] = (solid_volume(m, xp) - solid_volume(m, xm)) / (2 * delta);
     }
     worst = std::max(worst, (f[i] - (-P * grad)).norm());
   }
   EXPECT_LT(worst, 1e-10 * fmax) << "largest nodal force " << fmax << " N";
+  EXPECT_NEAR(enclosed_cavity_volume(m, x, Vec3::Zero()), -solid_volume(m, x), 1e-12 * 27 * h * h * h);
 }
 
 TEST(ForcesPressure, PushesTheWallAwayFromTheViscera) {

@@ -73,9 +73,9 @@ std::vector<double> force_scales(const RandomCase& c) {
   for (std::size_t e = 0; e < m.springs.size(); ++e)
     for (int32_t n : m.springs[e])
       s[n] += m.spring_k[e] * (m.spring_rest_m[e] + 2 * umax) + (c.model.damping ? m.spring_c[e] * vmax : 0.0);
-  for (const auto& t : m.cavity_tris) {
-    const double f = pressure_force_per_vertex(c.x[t[0]], c.x[t[1]], c.x[t[2]], c.model.pressure_pa).norm();
-    for (int32_t n : t) s[n] += f;
+  for (std::size_t l = 0; l < m.load_tet.size(); ++l) {
+    const auto f = pressure_load_forces(m, int64_t(l), c.x, c.model.pressure_pa);
+    for (int i = 0; i < 4; ++i) s[m.tets[m.load_tet[l]][i]] += f[i].norm();
   }
   for (std::size_t t = 0; t < m.tets.size(); ++t) {
     const auto& q = m.tets[t];
@@ -83,7 +83,7 @@ std::vector<double> force_scales(const RandomCase& c) {
     const double vol = signed_tet_volume(c.x[q[0]], c.x[q[1]], c.x[q[2]], c.x[q[3]]);
     const double v0 = m.tet_rest_volume_m3[t];
     for (int i = 0; i < 4; ++i)
-      s[q[i]] += std::abs(c.model.volume_stiffness_pa) * (std::abs(vol - v0) / v0 + 1.0) * g[i].norm();
+      s[q[i]] += std::abs(c.model.volume_stiffness_pa) * m.tet_fraction[t] * (std::abs(vol - v0) / v0 + 1.0) * g[i].norm();
   }
   for (int64_t n = 0; n < m.node_count(); ++n) s[n] += m.mass_kg[n] * c.model.gravity_m_s2.norm();
   return s;

@@ -193,8 +193,24 @@ std::vector<Row> rows() {
          s["roles"]["other_labels"] = {2};
          return write_tiny_case(d, s);
        },
-       {"no cavity triangles", "roles."}, 2, "out", kMeshCommands},
-      {"everything_fixed", [](D d) { return with_scene(d, "/mesh/cube_voxels", 8); },
+       {"no cavity faces", "roles."}, 2, "out", kMeshCommands},
+      {"everything_fixed",
+       [](D d) {
+         // Wall and viscera voxels in a checkerboard among fixed ones: every node of the 1-voxel cubes
+         // touches a fixed voxel.
+         Volume l = tiny_case_labels();
+         const Geometry& g = l.geometry();
+         for (int64_t k = 0; k < g.dims[2]; ++k)
+           for (int64_t j = 0; j < g.dims[1]; ++j)
+             for (int64_t i = 0; i < g.dims[0]; ++i)
+               l.data<uint8_t>()[g.linear_index(i, j, k)] =
+                   (k == 5 || k == 6) && tiny_case_label(i, j, k) != kTinyFixed && (i + j) % 2 == 0
+                       ? (k == 6 ? kTinyWall : kTinyViscera)
+                       : kTinyFixed;
+         json s = tiny_case_scene_json();
+         s["mesh"]["cube_voxels"] = 1;
+         return write_tiny_case(d, s, tiny_case_ct(), l);
+       },
        {"nodes is fixed", "nothing can move", "mesh.cube_voxels"}, 2, "out", kMeshCommands},
       {"wall_not_anchored",
        [](D d) {

@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/units.h"
+#include "load_test_support.h"
 #include "mesh/mesh.h"
 
 namespace pneumo {
@@ -44,11 +45,6 @@ Mesh build(const Voxels& v, int L, MeshModel model = MeshModel::Wall, std::optio
 using Key = std::array<int32_t, 3>;
 std::pair<Key, Key> sorted_pair(const Key& a, const Key& b) { return a < b ? std::make_pair(a, b) : std::make_pair(b, a); }
 
-/// Lattice coordinates (cube units) of a world point in metres: the inverse of the node placement
-/// (node (a,b,c) sits at the corner of voxel (aL, bL, cL), i.e. at voxel index aL − ½).
-Vec3 lattice_of(const Mesh& m, const Vec3& x_m) {
-  return (m.grid.to_index(x_m / units::kMetresPerMm) + Vec3::Constant(0.5)) / double(m.cube_voxels);
-}
 
 /// Lloyd's per-tetrahedron spring constant (§4), written out here independently of material.cpp.
 double lloyd_k(double E, double V) { return 2.0 * std::sqrt(2.0) / 25.0 * E * std::cbrt(6.0 * std::sqrt(2.0) * V); }
@@ -276,7 +272,8 @@ TEST(MeshGeometry, FlippedAndRotatedAxesKeepPositiveTetrahedra) {
     EXPECT_EQ(m.node_count(), ref.node_count());
     EXPECT_EQ(m.tets.size(), ref.tets.size());
     EXPECT_EQ(m.springs.size(), ref.springs.size());
-    EXPECT_EQ(m.cavity_tris.size(), ref.cavity_tris.size());
+    EXPECT_EQ(m.load_tet.size(), ref.load_tet.size());
+    EXPECT_EQ(m.stats.cavity_faces, ref.stats.cavity_faces);
     const double block = 27 * spacing.prod() * 1e-9;
     double total = 0.0;
     for (const auto& q : m.tets) {
@@ -289,12 +286,18 @@ TEST(MeshGeometry, FlippedAndRotatedAxesKeepPositiveTetrahedra) {
     std::sort(a.begin(), a.end());
     std::sort(b.begin(), b.end());
     for (std::size_t s = 0; s < a.size(); ++s) EXPECT_NEAR(a[s], b[s], 1e-12 * a[s]);
-    // Cavity triangles (wall surrounded by viscera: the whole surface) still point out of the block.
+    // The pressure loads (wall surrounded by viscera: the whole surface) still point out of the block,
+    // and their area vectors close: a closed surface's sum to zero.
     const Vec3 centre = m.grid.to_world(Vec3(2, 2, 2)) * units::kMetresPerMm;
-    for (const auto& t : m.cavity_tris) {
-      const Vec3 &x0 = m.rest_m[t[0]], &x1 = m.rest_m[t[1]], &x2 = m.rest_m[t[2]];
-      EXPECT_GT((x1 - x0).cross(x2 - x0).dot((x0 + x1 + x2) / 3.0 - centre), 0.0);
+    Vec3 closure = Vec3::Zero();
+    double area = 0.0;
+    for (std::size_t l = 0; l < m.load_tet.size(); ++l) {
+      const Vec3 a = load_area_vector(m, l);
+      EXPECT_GT(a.dot(load_centroid(m, l) - centre), 0.0);
+      closure += a;
+      area += a.norm();
     }
+    EXPECT_LE(closure.norm(), 1e-12 * area);
   }
 }
 
@@ -318,23 +321,13 @@ std::set<int64_t> cubes_of(const Mesh& m, Part p) {
   return s;
 }
 
-/// Whether the point (metres) lies inside a cube part p meshes.
-bool inside_part(const Mesh& m, const std::set<int64_t>& cubes, const Vec3& x_m) {
-  const Vec3 l = lattice_of(m, x_m);
-  const int64_t a = int64_t(std::floor(l[0])), b = int64_t(std::floor(l[1])), c = int64_t(std::floor(l[2]));
-  if (a < 0 || b < 0 || c < 0 || a >= m.cubes[0] || b >= m.cubes[1] || c >= m.cubes[2]) return false;
-  return cubes.count(a + m.cubes[0] * (b + m.cubes[1] * c)) > 0;
-}
 
-TEST(MeshParts, DoubledCubesSeparateNodesAndFacingCavityTriangles) {
+TEST(MeshParts, DoubledCubesSeparateNodesAndLoadTheVoxelInterface) {
   // Compared: a 2-voxel wall slab on viscera, L = 4 spanning both (the middle cube layer holds both roles),
   // against §3: 4 doubled cubes meshed once in each part (wall 8 cubes, viscera 8), two node sets that share
   // no node (no spring or tetrahedron joins the parts; counts are (2+1)²×3 lattice nodes per part), and
-  // cavity triangles on both parts: the wall's under its doubled layer (neighbour: viscera only), the
-  // viscera's over its doubled layer (neighbour: wall only), 4 faces × 2 triangles each. Each triangle's
-  // normal points out of its own solid (a point just beyond the face along the normal is outside every cube
-  // of its part, one just before it inside) and towards the other part (dot with the vector from its own
-  // part's centroid to the other's is positive). Exact counts; orientation by sign.
+  // pressure loads on both parts at the voxel interface inside the doubled layer (below). Exact counts;
+  // orientation by sign; areas and the centre of pressure to rounding.
   const Voxels v = slab_on_viscera();
   const Mesh m = build(v, 4, MeshModel::WallViscera);
   EXPECT_EQ(m.stats.doubled_cubes, 4);
@@ -358,29 +351,34 @@ TEST(MeshParts, DoubledCubesSeparateNodesAndFacingCavityTriangles) {
   }
   for (int p = 0; p < 2; ++p) centroid[p] /= count[p];
   const std::set<int64_t> cubes[2] = {cubes_of(m, Part::Wall), cubes_of(m, Part::Viscera)};
-  int tris[2] = {0, 0};
+  // Loads: the interface is the voxel plane between k = 6 and 7 (z = 13 mm), inside the doubled cubes (which
+  // span z = 7…15 mm), not on a cube face. Each part's loads sit in its copies of the doubled cubes, point
+  // at the other part, sum to the interface's area (4 cube faces of 8 mm) and their centre of pressure is
+  // the voxel plane itself, within rounding.
+  Vec3 area[2] = {Vec3::Zero(), Vec3::Zero()};
+  double moment_z[2] = {0, 0};
   const double h = units::mm_to_m(8.0);
-  for (std::size_t r = 0; r < m.cavity_tris.size(); ++r) {
-    const auto& t = m.cavity_tris[r];
-    const int p = int(m.tri_part[r]);
-    ++tris[p];
-    for (int32_t n : t) EXPECT_EQ(int(m.node_part[n]), p);
-    const Vec3 &x0 = m.rest_m[t[0]], &x1 = m.rest_m[t[1]], &x2 = m.rest_m[t[2]];
-    const Vec3 normal = (x1 - x0).cross(x2 - x0).normalized();
-    const Vec3 c = (x0 + x1 + x2) / 3.0;
-    EXPECT_FALSE(inside_part(m, cubes[p], c + 0.1 * h * normal)) << "triangle " << r << " points into its solid";
-    EXPECT_TRUE(inside_part(m, cubes[p], c - 0.1 * h * normal)) << "triangle " << r << " is not on its solid";
-    EXPECT_GT(normal.dot(centroid[1 - p] - centroid[p]), 0.0) << "triangle " << r << " faces away from the other part";
+  for (std::size_t l = 0; l < m.load_tet.size(); ++l) {
+    const int p = int(m.tet_part[m.load_tet[l]]);
+    EXPECT_TRUE(cubes[0].count(m.tet_cube[m.load_tet[l]]) && cubes[1].count(m.tet_cube[m.load_tet[l]]));
+    const Vec3 a = load_area_vector(m, l);
+    area[p] += a;
+    moment_z[p] += a.norm() * load_centroid(m, l)[2];
+    EXPECT_GT(a.dot(centroid[1 - p] - centroid[p]), 0.0) << "load " << l << " faces away from the other part";
   }
-  EXPECT_EQ(tris[0], 8);
-  EXPECT_EQ(tris[1], 8);
+  for (int p = 0; p < 2; ++p) {
+    EXPECT_NEAR(area[p].norm(), 4 * h * h, 1e-12 * h * h);
+    EXPECT_NEAR(moment_z[p] / area[p].norm(), units::mm_to_m(13.0), 1e-12);
+  }
+  EXPECT_NEAR((area[0] + area[1]).norm(), 0.0, 1e-12 * h * h);
+  EXPECT_EQ(m.stats.cavity_faces, 2 * 8 * 8);   // 8×8 voxel faces, seen from both sides
 }
 
-TEST(MeshParts, WallOnlyModelKeepsTheWallsCavityTriangles) {
+TEST(MeshParts, WallOnlyModelKeepsTheWallsPressureLoads) {
   // Compared: the same voxels with mesh.model = wall: no viscera cube, node or tetrahedron, the wall mesh
-  // identical in size to the two-part model's wall (8 cubes, 27 nodes), and its 8 cavity triangles still
-  // there (the neighbour cube holds viscera voxels even though they are not meshed), pointing out of the
-  // wall. Exact counts.
+  // identical in size to the two-part model's wall (8 cubes, 27 nodes), and its 8 pressure loads still
+  // there (the neighbour voxels are viscera even though they are not meshed), pointing out of the wall
+  // (down, −z, towards the viscera). Exact counts.
   const Voxels v = slab_on_viscera();
   const Mesh m = build(v, 4, MeshModel::Wall);
   EXPECT_EQ(m.stats.viscera_cubes, 0);
@@ -389,38 +387,43 @@ TEST(MeshParts, WallOnlyModelKeepsTheWallsCavityTriangles) {
   EXPECT_EQ(m.node_count(), 27);
   for (Part p : m.node_part) EXPECT_EQ(p, Part::Wall);
   for (Part p : m.tet_part) EXPECT_EQ(p, Part::Wall);
-  ASSERT_EQ(m.cavity_tris.size(), 8u);
-  const std::set<int64_t> wall = cubes_of(m, Part::Wall);
-  const double h = units::mm_to_m(8.0);
-  for (const auto& t : m.cavity_tris) {
-    const Vec3 &x0 = m.rest_m[t[0]], &x1 = m.rest_m[t[1]], &x2 = m.rest_m[t[2]];
-    const Vec3 normal = (x1 - x0).cross(x2 - x0).normalized();
-    EXPECT_FALSE(inside_part(m, wall, (x0 + x1 + x2) / 3.0 + 0.1 * h * normal));
-    EXPECT_TRUE(inside_part(m, wall, (x0 + x1 + x2) / 3.0 - 0.1 * h * normal));
+  ASSERT_GE(m.load_tet.size(), 8u);   // at least the 2 under each cube face, more where the plane cuts a cube
+  ASSERT_LE(m.load_tet.size(), 20u);  // at most the 5 of each of the 4 cubes
+  Vec3 total = Vec3::Zero();
+  for (std::size_t l = 0; l < m.load_tet.size(); ++l) {
+    const Vec3 a = load_area_vector(m, l);
+    EXPECT_LT(a[2], 0.0) << "load " << l << " points up, into the wall";
+    total += a;
   }
+  const double h = units::mm_to_m(8.0);
+  EXPECT_NEAR(total[2], -4 * h * h, 1e-12 * h * h);
 }
 
 // ---- fixed voxels, region of interest, empty input ---------------------------------------------------------------
 
-/// The lattice corners of every cube holding a fixed voxel.
+/// The lattice nodes a fixed voxel touches: node a (at voxel index aL − ½) is a corner of voxel i when
+/// aL = i or aL = i + 1.
 std::set<Key> fixed_corners(const Voxels& v, int L) {
   std::set<Key> s;
   for (int64_t k = 0; k < v.g.dims[2]; ++k)
     for (int64_t j = 0; j < v.g.dims[1]; ++j)
       for (int64_t i = 0; i < v.g.dims[0]; ++i)
         if (v.roles[v.g.linear_index(i, j, k)] == Role::Fixed)
-          for (int c = 0; c < 8; ++c)
-            s.insert({int32_t(i / L + (c & 1)), int32_t(j / L + ((c >> 1) & 1)), int32_t(k / L + ((c >> 2) & 1))});
+          for (int c = 0; c < 8; ++c) {
+            const int64_t corner[3] = {i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1)};
+            if (corner[0] % L || corner[1] % L || corner[2] % L) continue;
+            s.insert({int32_t(corner[0] / L), int32_t(corner[1] / L), int32_t(corner[2] / L)});
+          }
   return s;
 }
 
-TEST(MeshFixed, FixedCubesHoldTheirCornersAndNothingElse) {
-  // Compared: which nodes are held, against the corners of the cubes that hold a fixed voxel (§3), in three
-  // cases: (a) L = 1, a fixed voxel inside a wall block: its cube is not meshed, yet its 8 corners are nodes
-  // of the neighbouring wall cubes and are all held; (b) L = 2, one fixed voxel in a wall cube: the cube is
-  // meshed and held at its 8 corners, shared with neighbouring cubes; (c) the same with a viscera voxel in the
-  // cube too: both parts' copies of the 8 corners are held (16 nodes). Every other node is free (hold 0).
-  // Exact.
+TEST(MeshFixed, FixedVoxelsHoldTheNodesTheyTouchAndNothingElse) {
+  // Compared: which nodes are held, against the lattice nodes a fixed voxel touches (mesh.h: held only where
+  // bone is, not wherever a cube holds some), in three cases: (a) L = 1, a fixed voxel inside a wall block:
+  // its cube is not meshed, yet its 8 corners are nodes of the neighbouring wall cubes and are all held;
+  // (b) L = 2, one fixed voxel in a wall cube: only the cube's corner that the voxel touches is held, not the
+  // other 7 (the old cube-wide rule held all 8); (c) the same with a viscera voxel in the cube too: both
+  // parts' copies of that corner are held (2 nodes). Every other node is free (hold 0). Exact.
   struct Case {
     const char* name;
     int L;
@@ -428,8 +431,8 @@ TEST(MeshFixed, FixedCubesHoldTheirCornersAndNothingElse) {
     int64_t expected_fixed;
   };
   for (const Case& cs : {Case{"unmeshed fixed cube", 1, MeshModel::Wall, 8},
-                         Case{"meshed wall cube with a fixed voxel", 2, MeshModel::Wall, 8},
-                         Case{"doubled cube with a fixed voxel", 2, MeshModel::WallViscera, 16}}) {
+                         Case{"meshed wall cube with a fixed voxel", 2, MeshModel::Wall, 1},
+                         Case{"doubled cube with a fixed voxel", 2, MeshModel::WallViscera, 2}}) {
     SCOPED_TRACE(cs.name);
     Voxels v(6, 6, 6, 1.0, Role::Wall);
     if (cs.L == 1) {

@@ -125,7 +125,7 @@ TEST(Simulate, NoWallVisceraInterfaceIsAClearError) {
     simulate_scene(scene);
     FAIL() << "simulated without a cavity";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("no cavity triangles"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no cavity faces"), std::string::npos) << e.what();
   }
 }
 

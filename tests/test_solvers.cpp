@@ -328,11 +328,7 @@ std::vector<Equilibrium> four_equilibria(const Mesh& m, double volume_stiffness_
   forces.pressure_pa = units::mmhg_to_pa(10.0);
   forces.volume_stiffness_pa = volume_stiffness_pa;
   // F_ref as the monitor defines it: the largest nodal pressure force at rest.
-  std::vector<Vec3> fp(m.node_count(), Vec3::Zero());
-  for (const auto& t : m.cavity_tris) {
-    const Vec3 f = pressure_force_per_vertex(m.rest_m[t[0]], m.rest_m[t[1]], m.rest_m[t[2]], forces.pressure_pa);
-    for (int32_t i : t) fp[i] += f;
-  }
+  const std::vector<Vec3> fp = pressure_forces(m, m.rest_m, forces.pressure_pa);
   double f_ref = 0.0;
   for (const auto& f : fp) f_ref = std::max(f_ref, f.norm());
 

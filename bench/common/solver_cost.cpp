@@ -35,8 +35,10 @@ constexpr double kFlopsSpringEndCl = 39;
 // CPU reference: one evaluation per spring (d, length, direction, elastic part, damper: 29), then ± gathered at
 // both ends (3 each).
 constexpr double kFlopsSpringCpu = 29 + 6;
-constexpr double kFlopsTriangleCl = 36 + 9;     // two edges from rest + displacement, area normal, scaled; 3 gathers
-constexpr double kFlopsTriangleCpu = 24 + 9;    // two edges, area normal, scaled; 3 gathers
+// A pressure load: 3 edges (from rest + displacement on the device), 3 cross products (27), 4 vertices of
+// cof(D_s)·c (15 each) and the pressure's scale (12); 4 gathers.
+constexpr double kFlopsLoadCl = 18 + 27 + 60 + 12 + 12;
+constexpr double kFlopsLoadCpu = 9 + 27 + 60 + 12 + 12;
 constexpr double kFlopsTet = 90 + 12;           // 3 edges, 3 cross products, volumes, scale; 4 gathers
 constexpr double kFlopsGravity = 3;
 constexpr double kFlopsIntegratorCpu = 13;      // dt/m, v += (dt/m) f, x += dt v
@@ -46,18 +48,25 @@ constexpr double kClSpringRecordBytes = 7 * 4;                    // index, k, c
 constexpr double kClIntegratorBytes = 3 * 16 + 16 + 4 + 2 * 16;   // u, v, f, hold mask, 1/m; u, v written
 constexpr double kCpuIntegratorBytes = 3 * 24 + 8 + 1 + 2 * 24;   // x, v, f, mass, hold; x, v written
 
+/// The nodes of each pressure load's tetrahedron.
+std::vector<std::array<int32_t, 4>> load_nodes(const Mesh& m) {
+  std::vector<std::array<int32_t, 4>> out(m.load_tet.size());
+  for (std::size_t l = 0; l < out.size(); ++l) out[l] = m.tets[m.load_tet[l]];
+  return out;
+}
+
 }  // namespace
 
 /// gathered: the share of node blocks node_forces runs on (1, or the blocks with a free node in a solver's step).
 Cost cl_force_cost(const Mesh& m, const ForceModel& model, double spring_records_per_node, double gathered) {
   const int64_t N = m.node_count();
-  const double R = double(m.cavity_tris.size()), T = double(m.tets.size());
+  const double R = double(m.load_tet.size()), T = double(m.tets.size());
   double bytes = double(N) * (gathered * (16 + 16 + 4 + 4 + 16) + spring_records_per_node * kClSpringRecordBytes);
   double flops = double(N) * (spring_records_per_node * kFlopsSpringEndCl + kFlopsGravity);
   if (model.pressure_pa != 0.0 && R > 0) {
     const Adjacency a = Adjacency::of(m);
-    bytes += R * (16 + 16 + 16) + 32 * distinct_nodes(m.cavity_tris, N) + 4 * table_reads(a.tris, N);
-    flops += R * kFlopsTriangleCl;
+    bytes += R * (16 + 4 * 16 + 4 * 16) + 32 * distinct_nodes(load_nodes(m), N) + 4 * table_reads(a.loads, N);
+    flops += R * kFlopsLoadCl;
   }
   if (model.volume_stiffness_pa != 0.0 && T > 0) {
     const Adjacency a = Adjacency::of(m);
@@ -69,12 +78,12 @@ Cost cl_force_cost(const Mesh& m, const ForceModel& model, double spring_records
 
 Cost cpu_force_cost(const Mesh& m, const ForceModel& model) {
   const int64_t N = m.node_count();
-  const double S = double(m.springs.size()), R = double(m.cavity_tris.size()), T = double(m.tets.size());
+  const double S = double(m.springs.size()), R = double(m.load_tet.size()), T = double(m.tets.size());
   double bytes = double(N) * (24 + 24 + 8 + 8 + 24) + S * (8 + 3 * 8 + 24 + 24 + 2 * 4);
   double flops = S * kFlopsSpringCpu + double(N) * kFlopsGravity;
   if (model.pressure_pa != 0.0 && R > 0) {
-    bytes += R * (12 + 24 + 24 + 3 * 4) + 24 * distinct_nodes(m.cavity_tris, N) + double(N) * 8;
-    flops += R * kFlopsTriangleCpu;
+    bytes += R * (4 + 16 + 4 * 24 + 4 * 24 + 4 * 4) + 24 * distinct_nodes(load_nodes(m), N) + double(N) * 8;
+    flops += R * kFlopsLoadCpu;
   }
   if (model.volume_stiffness_pa != 0.0 && T > 0) {
     bytes += T * (16 + 8 + 2 * 96 + 4 * 4) + 24 * distinct_nodes(m.tets, N) + double(N) * 8;

@@ -185,7 +185,7 @@ json measure_case_throughput(BenchContext& ctx, const BenchCase& c, int pipeline
   out["nodes"] = st.nodes;
   out["springs"] = st.springs;
   out["tetrahedra"] = st.tetrahedra;
-  out["cavity_triangles"] = st.cavity_triangles;
+  out["cavity_faces"] = st.cavity_faces;
   out["solver"] = enum_name(c.scene.solver.method);
   out["seconds_input"] = c.seconds_input;
   out["seconds_roles"] = c.seconds_roles;

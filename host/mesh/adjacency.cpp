@@ -22,7 +22,9 @@ Adjacency Adjacency::of(const Mesh& m) {
   Adjacency a;
   a.springs = build(m.node_count(), m.springs);
   a.tets = build(m.node_count(), m.tets);
-  a.tris = build(m.node_count(), m.cavity_tris);
+  std::vector<std::array<int32_t, 4>> load_nodes(m.load_tet.size());
+  for (std::size_t l = 0; l < load_nodes.size(); ++l) load_nodes[l] = m.tets[m.load_tet[l]];
+  a.loads = build(m.node_count(), load_nodes);
   return a;
 }
 

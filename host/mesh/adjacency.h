@@ -1,5 +1,5 @@
 #pragma once
-// For each node, the springs, tetrahedra and cavity triangles it belongs to (compressed rows), so
+// For each node, the springs, tetrahedra and pressure loads it belongs to (compressed rows), so
 // forces can be gathered per node: deterministic and parallel without atomics.
 #include <cstdint>
 #include <vector>
@@ -16,7 +16,7 @@ struct Csr {
 };
 
 struct Adjacency {
-  Csr springs, tets, tris;
+  Csr springs, tets, loads;   // loads: the pressure loads whose tetrahedron holds the node
   /// Neighbouring nodes through springs, for the sequential 2004 scheme.
   static Adjacency of(const Mesh& m);
 };

@@ -26,6 +26,20 @@ inline constexpr std::array<Tet, 5> cube_tets(bool odd_cube) {
   return {{{0, 3, 5, 6}, {1, 0, 3, 5}, {2, 0, 3, 6}, {4, 0, 5, 6}, {7, 3, 5, 6}}};
 }
 
+/// Which of cube_tets(odd_cube) holds the point u of the unit cube (local coordinates in [0,1]³):
+/// corner tetrahedron k (1..4) is the set Σ_a |u_a − o_a| ≤ 1 around its corner o, the central one
+/// (0) the rest. Points on a shared face go to the corner tetrahedron.
+inline int tet_holding(const std::array<double, 3>& u, bool odd_cube) {
+  const auto tets = cube_tets(odd_cube);
+  for (int k = 1; k < 5; ++k) {
+    const auto o = corner_offset(tets[k][0]);
+    double d = 0.0;
+    for (int a = 0; a < 3; ++a) d += o[a] ? 1.0 - u[a] : u[a];
+    if (d <= 1.0) return k;
+  }
+  return 0;
+}
+
 /// The 6 faces of a cube: axis (0,1,2), side (0 = low, 1 = high) and its 4 corners in cyclic order.
 struct Face {
   int axis, side;

@@ -19,7 +19,9 @@ void assign_material(Mesh& m, const MaterialOptions& opt) {
   m.spring_k.assign(m.springs.size(), 0.0);
   for (std::size_t t = 0; t < m.tets.size(); ++t) {
     const double v = m.tet_rest_volume_m3[t];
-    for (int32_t n : m.tets[t]) m.mass_kg[n] += opt.density_kg_m3 * v / 4.0;
+    // §4 with the tissue that fills the tetrahedron only (mesh.h): ρ f_t V_t / 4 per vertex.
+    const double f = m.tet_fraction.empty() ? 1.0 : m.tet_fraction[t];
+    for (int32_t n : m.tets[t]) m.mass_kg[n] += opt.density_kg_m3 * f * v / 4.0;
     const double k = opt.spring_scale * lloyd_tet_spring_k(m.tet_young_pa[t], v);
     for (int32_t s : m.tet_springs[t]) m.spring_k[s] += k;
   }

@@ -1,7 +1,14 @@
 #pragma once
 // The mass-spring-damper mesh (method.md §3–4): nodes at cube corners of an L×L×L-voxel grid, 5
 // tetrahedra per cube, springs and dampers on every tetrahedron edge, separate wall and viscera
-// meshes (doubled where they touch), fixed nodes and cavity-facing triangles.
+// meshes (doubled where they touch), fixed nodes and the gas pressure's load.
+//
+// The geometry is resolved at the voxel, not the cube (docs/fidelity.md): a cube only says where
+// nodes may be. Each tetrahedron's stiffness and mass are the share of its volume that its part's
+// tissue fills (as the finite cell method weights cut cells), a node is held only where a fixed
+// voxel touches it, and the pressure acts on the voxel faces between wall and viscera, each carried
+// by the tetrahedron that holds it (an embedded surface). So the model converges as cubes shrink
+// instead of thickening the wall and the fixed region by up to a cube.
 //
 // Units: positions in metres (world RAS+), masses in kg, stiffness in N/m, damping in N·s/m,
 // volumes in m³. Interfaces convert to mm where users see them.
@@ -33,6 +40,12 @@ struct VoxelRoles {
   const uint16_t* label = nullptr;  // optional: organ labels for per-label Young's modulus
 };
 
+/// The smallest share of a tetrahedron's volume counted as its tissue: tetrahedra of a meshed cube
+/// that hold (almost) none of their part's tissue keep this fraction of its stiffness and mass, so
+/// no node is left without stiffness or mass (the finite cell method's α). At 10⁻³ the fictitious
+/// material moves a result by well under 1 % (docs/fidelity.md).
+inline constexpr double kMinTissueFraction = 1e-3;
+
 struct MeshOptions {
   int cube_voxels = 8;                     // L
   MeshModel model = MeshModel::WallViscera;
@@ -40,7 +53,9 @@ struct MeshOptions {
 };
 
 struct MeshStats {
-  int64_t nodes = 0, tetrahedra = 0, springs = 0, cavity_triangles = 0, fixed_nodes = 0;
+  int64_t nodes = 0, tetrahedra = 0, springs = 0, fixed_nodes = 0;
+  int64_t cavity_faces = 0;        // voxel faces between wall and viscera, both sides counted
+  int64_t pressure_tetrahedra = 0; // tetrahedra carrying some of them
   int64_t wall_cubes = 0, viscera_cubes = 0, doubled_cubes = 0;
   int64_t wall_nodes = 0, viscera_nodes = 0;
 };
@@ -57,9 +72,10 @@ struct Mesh {
   std::vector<std::array<int32_t, 4>> tets;
   std::vector<Part> tet_part;
   std::vector<uint16_t> tet_label;          // dominant label of its part in its cube
+  std::vector<double> tet_fraction;         // share of its volume its part's tissue fills (≥ kMinTissueFraction)
   std::vector<int64_t> tet_cube;            // linear cube index
   std::vector<double> tet_rest_volume_m3;
-  std::vector<double> tet_young_pa;
+  std::vector<double> tet_young_pa;         // the volume average over its tissue (0 outside it), floored
   std::vector<std::array<int32_t, 6>> tet_springs;   // spring of each local edge (kTetEdges order)
 
   // Springs (one per unique tetrahedron edge, per part).
@@ -68,9 +84,15 @@ struct Mesh {
   std::vector<double> spring_k;             // N/m, §4: Σ over tetrahedra sharing the edge
   std::vector<double> spring_c;             // N·s/m, §4: 2ζ√(m k)
 
-  // Cavity triangles: oriented with the normal out of their own part's solid (§3).
-  std::vector<std::array<int32_t, 3>> cavity_tris;
-  std::vector<Part> tri_part;
+  // Gas pressure (§5) on the voxel faces between wall and viscera tissue, embedded in the
+  // tetrahedra that hold them. Load l sits on tetrahedron load_tet[l]; with B_i = Σ_faces w_i N dA
+  // (w_i the face's barycentric weight of vertex i, N dA its rest area vector out of its own
+  // solid, m²) and D_m the rest edge matrix, load_c[l][i] = D_mᵀ B_i / det D_m. Nanson's formula
+  // (n da = cof F · N dA, F = D_s D_m⁻¹) then gives the follower force on vertex i as
+  // f_i = −P · cof(D_s) · c_i (pressure_load_forces): exact for flat faces under the tetrahedron's
+  // affine map. A face of the tetrahedron itself is the special case of the old cavity triangles.
+  std::vector<int32_t> load_tet;
+  std::vector<std::array<Vec3, 4>> load_c;
 
   // Where it came from.
   Geometry grid;                            // the voxel grid
@@ -82,7 +104,8 @@ struct Mesh {
 };
 
 /// Builds the mesh from voxel roles (§3). Throws InputError when nothing would be meshed.
-/// Young's modulus per tetrahedron comes from `young_pa_for(role, label)`.
+/// Young's modulus per tetrahedron is the average of `young_pa_for(role, label)` over the points
+/// of it that hold its part's tissue (0 elsewhere).
 Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const std::function<double(Role, int)>& young_pa_for);
 
 /// u = x − x₀ per node (metres): what deformation.bin, checkpoints and the warp carry.
@@ -101,6 +124,14 @@ void assign_material(Mesh& mesh, const MaterialOptions& opt);
 
 /// Lloyd's per-tetrahedron spring constant for ν = 1/4 (§4): (2√2/25)·E·(6√2·V)^(1/3), N/m.
 double lloyd_tet_spring_k(double young_pa, double volume_m3);
+
+/// The 4 vertex forces of pressure load l at positions x (§5): f_i = −P · cof(D_s) · c_i.
+std::array<Vec3, 4> pressure_load_forces(const Mesh& m, int64_t l, const std::vector<Vec3>& x, double pressure_pa);
+/// The gas volume the cavity faces enclose at positions x (m³), relative to `origin` (a point near
+/// them keeps the open rim's share small): −⅓ Σ_faces (x_f − origin) · n da.
+double enclosed_cavity_volume(const Mesh& m, const std::vector<Vec3>& x, const Vec3& origin);
+/// The pressure's nodal forces at positions x (one entry per node).
+std::vector<Vec3> pressure_forces(const Mesh& m, const std::vector<Vec3>& x, double pressure_pa);
 
 /// Signed volume of the tetrahedron (a,b,c,d), positive when (b−a, c−a, d−a) is right-handed.
 inline double signed_tet_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {

@@ -23,12 +23,6 @@ namespace {
 
 constexpr int kParts = 2;
 
-/// Per cube: which roles its voxels hold, and each part's dominant label.
-struct CubeContent {
-  bool has[4] = {false, false, false, false};   // indexed by Role
-  uint16_t label[kParts] = {0, 0};
-};
-
 struct Lattice {
   std::array<int64_t, 3> cubes{};
   int64_t cube_index(int64_t a, int64_t b, int64_t c) const { return a + cubes[0] * (b + cubes[1] * c); }
@@ -41,14 +35,36 @@ struct Lattice {
   }
 };
 
+/// Sample points per voxel and axis: at least 4 per cube edge, so that even with 1-voxel cubes each
+/// corner tetrahedron (a sixth of the cube) holds several. With s·L samples along an edge at
+/// (m + ½)/(s·L), no sample lies on a tetrahedron's face (Σ|u − o| is never exactly 1).
+int samples_per_voxel(int L) { return std::max(1, (4 + L - 1) / L); }
+
+/// Per cube: which roles its voxels hold, each part's dominant label, and per part and tetrahedron
+/// (cube_tets order) how many sample points hold the part's tissue, with their labels.
+struct CubeContent {
+  bool has[4] = {false, false, false, false};   // indexed by Role
+  uint16_t label[kParts] = {0, 0};
+  // (label, samples) of part p's tissue in tetrahedron k.
+  std::vector<std::pair<uint16_t, int32_t>> tissue[kParts][5];
+};
+
+void add_sample(std::vector<std::pair<uint16_t, int32_t>>& v, uint16_t label) {
+  for (auto& e : v)
+    if (e.first == label) { ++e.second; return; }
+  v.emplace_back(label, 1);
+}
+
 std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& lat, int L) {
   const Geometry& g = roles.geometry;
+  const int s = samples_per_voxel(L);
   std::vector<CubeContent> out(lat.cubes[0] * lat.cubes[1] * lat.cubes[2]);
 #pragma omp parallel for schedule(dynamic) collapse(2)
   for (int64_t c = 0; c < lat.cubes[2]; ++c)
     for (int64_t b = 0; b < lat.cubes[1]; ++b)
       for (int64_t a = 0; a < lat.cubes[0]; ++a) {
         CubeContent cc;
+        const bool odd = ((a + b + c) & 1) != 0;
         std::map<uint16_t, int> counts[kParts];
         for (int64_t k = c * L; k < std::min<int64_t>((c + 1) * L, g.dims[2]); ++k)
           for (int64_t j = b * L; j < std::min<int64_t>((b + 1) * L, g.dims[1]); ++j)
@@ -56,23 +72,157 @@ std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& 
               const int64_t v = g.linear_index(i, j, k);
               const Role r = roles.role[v];
               cc.has[static_cast<int>(r)] = true;
-              if (roles.label && (r == Role::Wall || r == Role::Viscera))
-                ++counts[r == Role::Wall ? 0 : 1][roles.label[v]];
+              if (r != Role::Wall && r != Role::Viscera) continue;
+              const int p = r == Role::Wall ? 0 : 1;
+              const uint16_t id = roles.label ? roles.label[v] : 0;
+              ++counts[p][id];
+              // The voxel's sample points, in the cube's local coordinates u ∈ [0,1]³.
+              for (int mz = 0; mz < s; ++mz)
+                for (int my = 0; my < s; ++my)
+                  for (int mx = 0; mx < s; ++mx) {
+                    const std::array<double, 3> u{(double(i - a * L) + (mx + 0.5) / s) / L,
+                                                  (double(j - b * L) + (my + 0.5) / s) / L,
+                                                  (double(k - c * L) + (mz + 0.5) / s) / L};
+                    add_sample(cc.tissue[p][lattice::tet_holding(u, odd)], id);
+                  }
             }
         for (int p = 0; p < kParts; ++p) {
           int best = -1;
           for (auto [id, n] : counts[p])
             if (n > best) { best = n; cc.label[p] = id; }
         }
-        out[lat.cube_index(a, b, c)] = cc;
+        out[lat.cube_index(a, b, c)] = std::move(cc);
       }
   return out;
+}
+
+/// Sample points of a whole cube in each of its tetrahedra (the same for both patterns, by symmetry).
+std::array<int64_t, 5> samples_per_tet(int L) {
+  const int n = samples_per_voxel(L) * L;
+  std::array<int64_t, 5> count{};
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x)
+        ++count[lattice::tet_holding({(x + 0.5) / n, (y + 0.5) / n, (z + 0.5) / n}, false)];
+  return count;
 }
 
 /// Rest position of lattice node (a,b,c): the corner of voxel (aL, bL, cL) at index aL − ½.
 Vec3 node_world_m(const Geometry& g, int64_t a, int64_t b, int64_t c, int L) {
   const Vec3 idx(double(a * L) - 0.5, double(b * L) - 0.5, double(c * L) - 0.5);
   return g.to_world(idx) * units::kMetresPerMm;
+}
+
+/// Whether a fixed voxel touches the lattice node (a,b,c): one of the 8 voxels sharing its corner.
+bool touches_fixed(const VoxelRoles& roles, int64_t a, int64_t b, int64_t c, int L) {
+  const Geometry& g = roles.geometry;
+  for (int64_t k = c * L - 1; k <= c * L; ++k)
+    for (int64_t j = b * L - 1; j <= b * L; ++j)
+      for (int64_t i = a * L - 1; i <= a * L; ++i) {
+        if (i < 0 || j < 0 || k < 0 || i >= g.dims[0] || j >= g.dims[1] || k >= g.dims[2]) continue;
+        if (roles.role[g.linear_index(i, j, k)] == Role::Fixed) return true;
+      }
+  return false;
+}
+
+/// The pressure loads (mesh.h): every voxel face between a voxel of part p and one of the other
+/// part's role, split into 4 triangles (centre and each edge) so each lies in one tetrahedron face
+/// when L = 1, carried by part p's tetrahedron in the voxel's cube that holds the triangle's centroid.
+void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, int L,
+                          const std::vector<uint8_t>& meshed, const std::vector<int32_t> (&first_tet)[kParts]) {
+  const Geometry& g = roles.geometry;
+  struct Accum {
+    int32_t tet;
+    std::array<Vec3, 4> b;
+    int64_t faces;
+  };
+  std::vector<std::vector<Accum>> per_slab(std::size_t(lat.cubes[2]));
+#pragma omp parallel for schedule(dynamic)
+  for (int64_t c = 0; c < lat.cubes[2]; ++c) {
+    std::vector<Accum>& out = per_slab[c];
+    for (int64_t b = 0; b < lat.cubes[1]; ++b)
+      for (int64_t a = 0; a < lat.cubes[0]; ++a) {
+        const int64_t q = lat.cube_index(a, b, c);
+        if (meshed[q] == 0) continue;
+        const bool odd = ((a + b + c) & 1) != 0;
+        Accum acc[kParts][5];
+        for (int p = 0; p < kParts; ++p)
+          for (int k = 0; k < 5; ++k) acc[p][k] = Accum{-1, {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()}, 0};
+        for (int64_t k = c * L; k < std::min<int64_t>((c + 1) * L, g.dims[2]); ++k)
+          for (int64_t j = b * L; j < std::min<int64_t>((b + 1) * L, g.dims[1]); ++j)
+            for (int64_t i = a * L; i < std::min<int64_t>((a + 1) * L, g.dims[0]); ++i) {
+              const Role r = roles.role[g.linear_index(i, j, k)];
+              if (r != Role::Wall && r != Role::Viscera) continue;
+              const int p = r == Role::Wall ? 0 : 1;
+              if (!(meshed[q] & (1 << p))) continue;
+              const Role other = p == 0 ? Role::Viscera : Role::Wall;
+              const int64_t idx[3] = {i, j, k};
+              for (int axis = 0; axis < 3; ++axis)
+                for (int side = -1; side <= 1; side += 2) {
+                  int64_t n[3] = {i, j, k};
+                  n[axis] += side;
+                  if (n[axis] < 0 || n[axis] >= g.dims[axis]) continue;
+                  if (roles.role[g.linear_index(n[0], n[1], n[2])] != other) continue;
+                  // The face's centre and corners in index space; the 4 triangles (centre, corner q, q+1).
+                  const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+                  Vec3 centre = Vec3(double(i), double(j), double(k));
+                  centre[axis] += 0.5 * side;
+                  const double cu[4] = {-0.5, 0.5, 0.5, -0.5}, cw[4] = {-0.5, -0.5, 0.5, 0.5};
+                  const Vec3 outward_world = g.to_world(Vec3(double(n[0]), double(n[1]), double(n[2]))) -
+                                             g.to_world(Vec3(double(idx[0]), double(idx[1]), double(idx[2])));
+                  for (int t = 0; t < 4; ++t) {
+                    Vec3 p1 = centre, p2 = centre;
+                    p1[u] += cu[t];
+                    p1[w] += cw[t];
+                    p2[u] += cu[(t + 1) % 4];
+                    p2[w] += cw[(t + 1) % 4];
+                    const Vec3 centroid = (centre + p1 + p2) / 3.0;
+                    const Vec3 x0 = g.to_world(centre) * units::kMetresPerMm, x1 = g.to_world(p1) * units::kMetresPerMm,
+                               x2 = g.to_world(p2) * units::kMetresPerMm;
+                    Vec3 area = 0.5 * (x1 - x0).cross(x2 - x0);
+                    if (area.dot(outward_world) < 0) area = -area;
+                    const std::array<double, 3> uc{(centroid[0] + 0.5 - double(a * L)) / L,
+                                                   (centroid[1] + 0.5 - double(b * L)) / L,
+                                                   (centroid[2] + 0.5 - double(c * L)) / L};
+                    const int kt = lattice::tet_holding(uc, odd);
+                    Accum& ac = acc[p][kt];
+                    ac.tet = first_tet[p][q] + kt;
+                    const auto& tv = m.tets[ac.tet];
+                    const Vec3& X0 = m.rest_m[tv[0]];
+                    Mat3 dm;
+                    dm << m.rest_m[tv[1]] - X0, m.rest_m[tv[2]] - X0, m.rest_m[tv[3]] - X0;
+                    const Vec3 wts = dm.inverse() * (g.to_world(centroid) * units::kMetresPerMm - X0);
+                    const double w4[4] = {1.0 - wts.sum(), wts[0], wts[1], wts[2]};
+                    for (int v = 0; v < 4; ++v) ac.b[v] += w4[v] * area;
+                  }
+                  ++acc[p][0].faces;   // counted once per face, whichever tetrahedra carry it
+                }
+            }
+        for (int p = 0; p < kParts; ++p) {
+          int64_t faces = acc[p][0].faces;
+          for (int k = 0; k < 5; ++k) {
+            if (acc[p][k].tet < 0) continue;
+            acc[p][k].faces = faces;
+            faces = 0;
+            out.push_back(acc[p][k]);
+          }
+        }
+      }
+  }
+  for (const auto& slab : per_slab)
+    for (const Accum& ac : slab) {
+      const auto& tv = m.tets[ac.tet];
+      const Vec3& X0 = m.rest_m[tv[0]];
+      Mat3 dm;
+      dm << m.rest_m[tv[1]] - X0, m.rest_m[tv[2]] - X0, m.rest_m[tv[3]] - X0;
+      const double det = dm.determinant();
+      std::array<Vec3, 4> cvec;
+      for (int v = 0; v < 4; ++v) cvec[v] = dm.transpose() * ac.b[v] / det;
+      m.load_tet.push_back(ac.tet);
+      m.load_c.push_back(cvec);
+      m.stats.cavity_faces += ac.faces;
+    }
+  m.stats.pressure_tetrahedra = int64_t(m.load_tet.size());
 }
 
 }  // namespace
@@ -86,6 +236,7 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt,
   for (int a = 0; a < 3; ++a) lat.cubes[a] = (g.dims[a] + L - 1) / L;
 
   const std::vector<CubeContent> content = classify_cubes(roles, lat, L);
+  const std::array<int64_t, 5> tet_samples = samples_per_tet(L);
   const bool with_viscera = opt.model == MeshModel::WallViscera;
 
   auto in_roi = [&](int64_t a, int64_t b, int64_t c) {
@@ -93,7 +244,7 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt,
     const Vec3 centre = g.to_world(Vec3((a + 0.5) * L - 0.5, (b + 0.5) * L - 0.5, (c + 0.5) * L - 0.5));
     return (centre.array() >= opt.roi_min_mm->array()).all() && (centre.array() <= opt.roi_max_mm->array()).all();
   };
-  // Which parts mesh each cube.
+  // Which parts mesh each cube: those with a voxel of their role in it.
   std::vector<uint8_t> meshed(content.size(), 0);   // bit p: part p meshes the cube
   for (int64_t c = 0; c < lat.cubes[2]; ++c)
     for (int64_t b = 0; b < lat.cubes[1]; ++b)
@@ -124,7 +275,8 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt,
     return id;
   };
 
-  const auto faces = lattice::cube_faces();
+  std::vector<int32_t> first_tet[kParts];
+  for (int p = 0; p < kParts; ++p) first_tet[p].assign(content.size(), -1);
   for (int64_t c = 0; c < lat.cubes[2]; ++c)
     for (int64_t b = 0; b < lat.cubes[1]; ++b)
       for (int64_t a = 0; a < lat.cubes[0]; ++a) {
@@ -142,37 +294,30 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt,
           }
           const Role role = p == 0 ? Role::Wall : Role::Viscera;
           const uint16_t label = content[q].label[p];
-          const double young = young_pa_for(role, label);
-          for (const auto& t : lattice::cube_tets(odd)) {
+          const double floor_young = kMinTissueFraction * young_pa_for(role, label);
+          first_tet[p][q] = int32_t(m.tets.size());
+          const auto tets = lattice::cube_tets(odd);
+          for (int k = 0; k < 5; ++k) {
+            const auto& t = tets[k];
             std::array<int32_t, 4> tet{corner_node[t[0]], corner_node[t[1]], corner_node[t[2]], corner_node[t[3]]};
             double vol = signed_tet_volume(m.rest_m[tet[0]], m.rest_m[tet[1]], m.rest_m[tet[2]], m.rest_m[tet[3]]);
             if (vol < 0) { std::swap(tet[2], tet[3]); vol = -vol; }
+            // The volume average of the modulus over the tetrahedron, tissue of the part counted
+            // with its own modulus and anything else (air, bone, the other part) with none.
+            double young_sum = 0.0;
+            int64_t tissue = 0;
+            for (auto [id, n] : content[q].tissue[p][k]) {
+              young_sum += double(n) * young_pa_for(role, id);
+              tissue += n;
+            }
+            const double total = double(tet_samples[k]);
             m.tets.push_back(tet);
             m.tet_part.push_back(Part(p));
             m.tet_label.push_back(label);
             m.tet_cube.push_back(q);
             m.tet_rest_volume_m3.push_back(vol);
-            m.tet_young_pa.push_back(young);
-          }
-          // Cavity triangles: faces on this part's boundary whose neighbour cube holds the other
-          // part's role (the gas enters between wall and viscera there).
-          const Vec3 cube_centre = node_world_m(g, a, b, c, L) * 0.5 + node_world_m(g, a + 1, b + 1, c + 1, L) * 0.5;
-          for (const auto& f : faces) {
-            int64_t n[3] = {a, b, c};
-            n[f.axis] += f.side ? 1 : -1;
-            if (!lat.inside(n[0], n[1], n[2])) continue;
-            const int64_t nq = lat.cube_index(n[0], n[1], n[2]);
-            if (meshed[nq] & (1 << p)) continue;   // interior face of this part
-            const Role other = p == 0 ? Role::Viscera : Role::Wall;
-            if (!content[nq].has[int(other)]) continue;
-            for (auto tri : lattice::face_triangles(f, odd)) {
-              std::array<int32_t, 3> t{corner_node[tri[0]], corner_node[tri[1]], corner_node[tri[2]]};
-              const Vec3 &x0 = m.rest_m[t[0]], &x1 = m.rest_m[t[1]], &x2 = m.rest_m[t[2]];
-              const Vec3 normal = (x1 - x0).cross(x2 - x0);
-              if (normal.dot((x0 + x1 + x2) / 3.0 - cube_centre) < 0) std::swap(t[1], t[2]);
-              m.cavity_tris.push_back(t);
-              m.tri_part.push_back(Part(p));
-            }
+            m.tet_fraction.push_back(std::max(double(tissue) / total, kMinTissueFraction));
+            m.tet_young_pa.push_back(std::max(young_sum / total, floor_young));
           }
         }
       }
@@ -183,19 +328,20 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt,
     throw InputError(os.str());
   }
 
-  // Fixed nodes: every corner of a cube that holds a fixed voxel, meshed or not (§3), so a wall that
-  // touches the back across a cube face is anchored there.
-  for (int64_t c = 0; c < lat.cubes[2]; ++c)
-    for (int64_t b = 0; b < lat.cubes[1]; ++b)
-      for (int64_t a = 0; a < lat.cubes[0]; ++a) {
-        if (!content[lat.cube_index(a, b, c)].has[int(Role::Fixed)]) continue;
-        for (int k = 0; k < 8; ++k) {
-          const auto o = lattice::corner_offset(k);
-          const int64_t ni = lat.node_index(a + o[0], b + o[1], c + o[2]);
-          for (int p = 0; p < kParts; ++p)
-            if (node_id[p][ni] >= 0) m.hold[node_id[p][ni]] = kHoldAll;
-        }
+  // Fixed nodes: a node is held where a fixed voxel touches it (one of the 8 voxels sharing its
+  // corner), in whichever parts have a node there. Bone inside a cube holds only the nodes that lie
+  // in it; the fixed region does not grow with the cube.
+  for (int64_t c = 0; c <= lat.cubes[2]; ++c)
+    for (int64_t b = 0; b <= lat.cubes[1]; ++b)
+      for (int64_t a = 0; a <= lat.cubes[0]; ++a) {
+        const int64_t ni = lat.node_index(a, b, c);
+        if (node_id[0][ni] < 0 && node_id[1][ni] < 0) continue;
+        if (!touches_fixed(roles, a, b, c, L)) continue;
+        for (int p = 0; p < kParts; ++p)
+          if (node_id[p][ni] >= 0) m.hold[node_id[p][ni]] = kHoldAll;
       }
+
+  build_pressure_loads(m, roles, lat, L, meshed, first_tet);
 
   // Springs: unique tetrahedron edges (per part: parts never share nodes).
   std::vector<std::pair<int64_t, int64_t>> edges;   // (node-pair key, 6·tet + local edge)
@@ -222,7 +368,6 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt,
   m.stats.nodes = N;
   m.stats.tetrahedra = int64_t(m.tets.size());
   m.stats.springs = int64_t(m.springs.size());
-  m.stats.cavity_triangles = int64_t(m.cavity_tris.size());
   for (int64_t i = 0; i < N; ++i) {
     m.stats.fixed_nodes += m.hold[i] == kHoldAll;
     ++(m.node_part[i] == Part::Wall ? m.stats.wall_nodes : m.stats.viscera_nodes);

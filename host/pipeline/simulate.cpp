@@ -49,13 +49,13 @@ Simulation prepare_simulation(const Scene& scene) {
   const MeshStats& s = sim.mesh.stats;
   std::ostringstream os;
   os << "mesh: " << s.nodes << " nodes, " << s.tetrahedra << " tetrahedra, " << s.springs << " springs, "
-     << s.cavity_triangles << " cavity triangles, " << s.fixed_nodes << " fixed nodes, " << s.doubled_cubes
+     << s.cavity_faces << " cavity faces, " << s.fixed_nodes << " fixed nodes, " << s.doubled_cubes
      << " doubled cubes";
   log::info(os.str());
   // Before starting a device: nothing free, or a part the load would carry away.
   check_solvable(sim.mesh, solve_options_from_scene(scene), "scene " + scene.path);
-  if (s.cavity_triangles == 0)
-    throw InputError("scene " + scene.path + ": the mesh has no cavity triangles (no wall/viscera interface): the gas "
+  if (s.cavity_faces == 0)
+    throw InputError("scene " + scene.path + ": the mesh has no cavity faces (no wall/viscera interface): the gas "
                      "has nowhere to act; check the role mapping (roles.*_labels) and mesh.model");
   return sim;
 }
@@ -157,17 +157,10 @@ DeformationMetrics deformation_metrics(const Mesh& m, const std::vector<Vec3>& x
   // normals point out of their solids, into the gas). The surfaces are open where they meet fixed
   // or unmeshed tissue; taking the rest centroid as origin keeps that rim's contribution small.
   Vec3 centroid = Vec3::Zero();
-  for (const auto& t : m.cavity_tris) centroid += (m.rest_m[t[0]] + m.rest_m[t[1]] + m.rest_m[t[2]]) / 3.0;
-  if (!m.cavity_tris.empty()) centroid /= double(m.cavity_tris.size());
-  auto enclosed = [&](const std::vector<Vec3>& p) {
-    double v = 0.0;
-    for (const auto& t : m.cavity_tris) {
-      const Vec3 a = p[t[0]] - centroid, b = p[t[1]] - centroid, c = p[t[2]] - centroid;
-      v -= a.dot((b - a).cross(c - a)) / 6.0;
-    }
-    return v;
-  };
-  d.cavity_volume_ml = (enclosed(x) - enclosed(m.rest_m)) * 1e6;   // m³ → ml
+  for (int32_t t : m.load_tet)
+    for (int32_t n : m.tets[t]) centroid += m.rest_m[n] / 4.0;
+  if (!m.load_tet.empty()) centroid /= double(m.load_tet.size());
+  d.cavity_volume_ml = (enclosed_cavity_volume(m, x, centroid) - enclosed_cavity_volume(m, m.rest_m, centroid)) * 1e6;   // m³ → ml
   return d;
 }
 
@@ -187,7 +180,8 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   j["nodes"] = s.nodes;
   j["tetrahedra"] = s.tetrahedra;
   j["springs"] = s.springs;
-  j["cavity_triangles"] = s.cavity_triangles;
+  j["cavity_faces"] = s.cavity_faces;
+  j["pressure_tetrahedra"] = s.pressure_tetrahedra;
   j["fixed_nodes"] = s.fixed_nodes;
   j["wall_cubes"] = s.wall_cubes;
   j["viscera_cubes"] = s.viscera_cubes;

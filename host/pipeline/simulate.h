@@ -31,7 +31,7 @@ struct Simulation {
 /// prepare_simulation then solve_simulation. A DivergedError propagates.
 Simulation simulate_scene(const Scene& scene);
 
-/// Roles and mesh (InputError when the mesh has no cavity triangles).
+/// Roles and mesh (InputError when the mesh has no cavity faces).
 Simulation prepare_simulation(const Scene& scene);
 
 /// What a caller adds to a solve: a start state (a resumed run's checkpoint) and an observer of

@@ -18,11 +18,6 @@ Vec3 spring_force_linear(const Vec3& xa, const Vec3& xb, const Vec3& xa0, const 
   return -k * ((xa - xb) - (xa0 - xb0)) - c * (va - vb);
 }
 
-Vec3 pressure_force_per_vertex(const Vec3& xa, const Vec3& xb, const Vec3& xc, double pressure_pa) {
-  const Vec3 area_normal = 0.5 * (xb - xa).cross(xc - xa);
-  return -pressure_pa * area_normal / 3.0;
-}
-
 std::array<Vec3, 4> tet_volume_gradient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   // V = (b−a)·((c−a)×(d−a))/6, written cyclically for c and d; ∂V/∂a follows from translation
   // invariance (the four gradients sum to zero).
@@ -39,13 +34,13 @@ ForceEvaluator::ForceEvaluator(const Mesh& mesh) : m_(mesh), adj_(Adjacency::of(
 void ForceEvaluator::evaluate(const ForceModel& model, const std::vector<Vec3>& x, const std::vector<Vec3>& v,
                               std::vector<Vec3>& f) {
   const Mesh& m = m_;
-  const int64_t S = int64_t(m.springs.size()), T = int64_t(m.tets.size()), R = int64_t(m.cavity_tris.size());
+  const int64_t S = int64_t(m.springs.size()), T = int64_t(m.tets.size()), R = int64_t(m.load_tet.size());
   const int64_t N = m.node_count();
   const bool damp = model.damping && !v.empty();
   static const Vec3 kZero = Vec3::Zero();
   spring_f_.resize(S);
   tet_f_.resize(model.volume_stiffness_pa != 0.0 ? 4 * T : 0);
-  tri_f_.resize(model.pressure_pa != 0.0 ? R : 0);
+  load_f_.resize(model.pressure_pa != 0.0 ? 4 * R : 0);
   f.resize(N);
 
   // Small meshes stay on one thread: a parallel region costs more than their whole evaluation.
@@ -70,15 +65,16 @@ void ForceEvaluator::evaluate(const ForceModel& model, const std::vector<Vec3>& 
         const double v0 = m.tet_rest_volume_m3[t];
         const double vol = signed_tet_volume(x[q[0]], x[q[1]], x[q[2]], x[q[3]]);
         const auto g = tet_volume_gradient(x[q[0]], x[q[1]], x[q[2]], x[q[3]]);
-        const double s = -model.volume_stiffness_pa * (vol - v0) / v0;
+        // k_v is a material property: the tissue that fills the tetrahedron carries it (mesh.h).
+        const double s = -model.volume_stiffness_pa * m.tet_fraction[t] * (vol - v0) / v0;
         for (int i = 0; i < 4; ++i) tet_f_[4 * t + i] = s * g[i];
       }
     }
-    if (!tri_f_.empty()) {
+    if (!load_f_.empty()) {
 #pragma omp for schedule(static)
       for (int64_t r = 0; r < R; ++r) {
-        const auto& q = m.cavity_tris[r];
-        tri_f_[r] = pressure_force_per_vertex(x[q[0]], x[q[1]], x[q[2]], model.pressure_pa);
+        const auto fl = pressure_load_forces(m, r, x, model.pressure_pa);
+        for (int i = 0; i < 4; ++i) load_f_[4 * r + i] = fl[i];
       }
     }
     // Gather per node, in a fixed order: the same sum whatever the thread count.
@@ -94,8 +90,11 @@ void ForceEvaluator::evaluate(const ForceModel& model, const std::vector<Vec3>& 
           const int32_t it = adj_.tets.item[e];
           sum += tet_f_[4 * (it / 8) + it % 8];
         }
-      if (!tri_f_.empty())
-        for (int64_t e = adj_.tris.begin(n); e < adj_.tris.end(n); ++e) sum += tri_f_[adj_.tris.item[e] / 8];
+      if (!load_f_.empty())
+        for (int64_t e = adj_.loads.begin(n); e < adj_.loads.end(n); ++e) {
+          const int32_t it = adj_.loads.item[e];
+          sum += load_f_[4 * (it / 8) + it % 8];
+        }
       f[n] = sum;
     }
   }
@@ -122,7 +121,7 @@ double volume_energy(const Mesh& m, const std::vector<Vec3>& x, double kv) {
     const auto& q = m.tets[t];
     const double v0 = m.tet_rest_volume_m3[t];
     const double strain = (signed_tet_volume(x[q[0]], x[q[1]], x[q[2]], x[q[3]]) - v0) / v0;
-    e += 0.5 * kv * v0 * strain * strain;
+    e += 0.5 * kv * m.tet_fraction[t] * v0 * strain * strain;
   }
   return e;
 }

@@ -11,7 +11,7 @@ namespace pneumo {
 struct ForceModel {
   SpringModel spring_model = SpringModel::Nonlinear;
   bool damping = true;                 // spring dampers c (§4)
-  double pressure_pa = 0.0;            // gas pressure on the cavity triangles
+  double pressure_pa = 0.0;            // gas pressure on the cavity faces (mesh.h)
   double volume_stiffness_pa = 0.0;    // Kitasaka's k_v; 0 = off
   Vec3 gravity_m_s2 = Vec3::Zero();    // option (Bano); zero = off
 };
@@ -30,7 +30,7 @@ class ForceEvaluator {
  private:
   const Mesh& m_;
   Adjacency adj_;
-  std::vector<Vec3> spring_f_, tet_f_, tri_f_;   // per element, before the gather
+  std::vector<Vec3> spring_f_, tet_f_, load_f_;   // per element, before the gather
   int64_t evaluations_ = 0;
 };
 
@@ -40,8 +40,6 @@ Vec3 spring_force_nonlinear(const Vec3& xa, const Vec3& xb, const Vec3& va, cons
 /// Nimura's Eq. 1 as printed (option): f_a = −k(d − d₀) − c v_ab. Not rotation-invariant.
 Vec3 spring_force_linear(const Vec3& xa, const Vec3& xb, const Vec3& xa0, const Vec3& xb0, const Vec3& va,
                          const Vec3& vb, double k, double c);
-/// Gas pressure on triangle (a,b,c): F = −P·S·n, S·n = ½(x_b − x_a)×(x_c − x_a), a third per vertex (§5).
-Vec3 pressure_force_per_vertex(const Vec3& xa, const Vec3& xb, const Vec3& xc, double pressure_pa);
 /// ∂V/∂x_i of a tetrahedron's signed volume, for its 4 vertices.
 std::array<Vec3, 4> tet_volume_gradient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 

@@ -23,7 +23,7 @@ int64_t degree(const Csr& c, int64_t n) { return c.end(n) - c.begin(n); }
 
 /// Nodes grouped into blocks of kBlock: nodes with a free axis first, fully held ones last (their
 /// blocks can be skipped when only free forces matter). Within windows of kWindow nodes in mesh
-/// (lattice) order, nodes are sorted by spring degree, then cavity-triangle and tetrahedron degree,
+/// (lattice) order, nodes are sorted by spring degree, then pressure-load and tetrahedron degree,
 /// so a block's nodes need about the same number of records while a pass still sweeps the lattice
 /// once: the neighbours a block gathers stay within a few lattice planes, in cache, on meshes far
 /// larger than the cache (a global sort would sweep it once per degree).
@@ -32,7 +32,7 @@ std::vector<int> block_nodes(const Mesh& m, const Adjacency& adj, int64_t& free_
   std::vector<int> free_nodes, held_nodes;
   for (int64_t n = 0; n < m.node_count(); ++n) (m.hold[n] == kHoldAll ? held_nodes : free_nodes).push_back(int(n));
   auto key = [&](int n) {
-    return std::array<int64_t, 3>{degree(adj.springs, n), degree(adj.tris, n), degree(adj.tets, n)};
+    return std::array<int64_t, 3>{degree(adj.springs, n), degree(adj.loads, n), degree(adj.tets, n)};
   };
   std::vector<int> order;
   for (std::vector<int>* part : {&free_nodes, &held_nodes}) {
@@ -84,19 +84,19 @@ struct DeviceBytes {
 
 /// Everything the evaluator allocates, before any of it is: node state (u, v, x₀, F: float4; mass;
 /// the block's nodes), the block tables (per record and lane: spring end, k, c, rest x/y/z/length: 28
-/// bytes; triangle or tetrahedron index: 4 bytes; and where each block's records begin), triangles
-/// and tetrahedra and their forces (with the zero entry past the last). The records are bounded by
-/// the widest block's: at most max degree per node.
-DeviceBytes evaluator_bytes(const Adjacency& adj, const std::vector<int>& blocks, int64_t nodes, int64_t tris,
+/// bytes; load or tetrahedron force index: 4 bytes; and where each block's records begin), the
+/// pressure loads (nodes, 4 vectors, 4 forces) and tetrahedra (nodes, fraction, 4 forces), with the
+/// zero entry past the last. The records are bounded by the widest block's: at most max degree per node.
+DeviceBytes evaluator_bytes(const Adjacency& adj, const std::vector<int>& blocks, int64_t nodes, int64_t loads,
                             int64_t tets, uint64_t extra_bytes_per_node) {
-  const uint64_t N = uint64_t(blocks.size()), T = uint64_t(tets), R = uint64_t(tris);
+  const uint64_t N = uint64_t(blocks.size()), T = uint64_t(tets), R = uint64_t(loads);
   const uint64_t block_begins = 3 * (N / kBlock + 1) * 4;
   const uint64_t spring_entries = uint64_t(max_degree(adj.springs, nodes)) * N;
   DeviceBytes b;
-  b.total = N * (4 * 16 + 4 + 4 + extra_bytes_per_node) + block_begins + spring_entries * 28 + (R + 1) * 32 +
-            uint64_t(max_degree(adj.tris, nodes)) * N * 4 + (T + 1) * (16 + 64) +
-            uint64_t(max_degree(adj.tets, nodes)) * N * 4;
-  b.largest = std::max({spring_entries * 4, (T + 1) * 64, N * 16});
+  b.total = N * (4 * 16 + 4 + 4 + extra_bytes_per_node) + block_begins + spring_entries * 28 +
+            R * (16 + 64) + (R + 1) * 64 + uint64_t(max_degree(adj.loads, nodes)) * N * 4 + T * 4 +
+            (T + 1) * (16 + 64) + uint64_t(max_degree(adj.tets, nodes)) * N * 4;
+  b.largest = std::max({spring_entries * 4, (T + 1) * 64, (R + 1) * 64, N * 16});
   return b;
 }
 
@@ -105,7 +105,7 @@ DeviceBytes evaluator_bytes(const Adjacency& adj, const std::vector<int>& blocks
 uint64_t ClForceEvaluator::device_bytes(const Mesh& m, uint64_t extra_bytes_per_node) {
   const Adjacency adj = Adjacency::of(m);
   int64_t free_blocks = 0;
-  return evaluator_bytes(adj, block_nodes(m, adj, free_blocks), m.node_count(), int64_t(m.cavity_tris.size()),
+  return evaluator_bytes(adj, block_nodes(m, adj, free_blocks), m.node_count(), int64_t(m.load_tet.size()),
                          int64_t(m.tets.size()), extra_bytes_per_node)
       .total;
 }
@@ -117,11 +117,11 @@ std::vector<cl_float4> to_float4(const std::vector<Vec3>& v) {
 }
 
 ClForceEvaluator::ClForceEvaluator(ocl::Context& ctx, const Mesh& m, uint64_t extra_bytes_per_node)
-    : ctx_(ctx), nodes_(m.node_count()), tris_(int64_t(m.cavity_tris.size())), tets_(int64_t(m.tets.size())) {
+    : ctx_(ctx), nodes_(m.node_count()), loads_(int64_t(m.load_tet.size())), tets_(int64_t(m.tets.size())) {
   const Adjacency adj = Adjacency::of(m);
   const std::vector<int> blocks = block_nodes(m, adj, free_blocks_);
   blocks_ = int64_t(blocks.size()) / kBlock;
-  const DeviceBytes needs = evaluator_bytes(adj, blocks, nodes_, tris_, tets_, extra_bytes_per_node);
+  const DeviceBytes needs = evaluator_bytes(adj, blocks, nodes_, loads_, tets_, extra_bytes_per_node);
   ctx.check_fits(needs.total, needs.largest, "this mesh (" + std::to_string(nodes_) + " nodes)");
 
   // Springs seen from each node: the other end, the spring's constants, the rest vector from the
@@ -172,15 +172,26 @@ ClForceEvaluator::ClForceEvaluator(ocl::Context& ctx, const Mesh& m, uint64_t ex
     begin_buf = upload(ctx, begin);
     table_buf = upload(ctx, table);
   };
-  element_table(adj.tris, int(tris_), [](int32_t it) { return it / 8; }, tri_begin_, node_tri_);
+  element_table(adj.loads, int(4 * loads_), [](int32_t it) { return 4 * (it / 8) + it % 8; }, load_begin_, node_load_);
   element_table(adj.tets, int(4 * tets_), [](int32_t it) { return 4 * (it / 8) + it % 8; }, tet_begin_, node_tet_);
 
-  std::vector<cl_int4> tris(m.cavity_tris.size()), tets(m.tets.size());
-  for (std::size_t t = 0; t < tris.size(); ++t)
-    tris[t] = {{m.cavity_tris[t][0], m.cavity_tris[t][1], m.cavity_tris[t][2], 0}};
+  std::vector<cl_int4> load_nodes(std::max<int64_t>(loads_, 1), cl_int4{{0, 0, 0, 0}}), tets(m.tets.size());
+  std::vector<cl_float4> load_c(4 * load_nodes.size(), cl_float4{{0, 0, 0, 0}});
+  for (int64_t l = 0; l < loads_; ++l) {
+    const auto& q = m.tets[m.load_tet[l]];
+    load_nodes[l] = {{q[0], q[1], q[2], q[3]}};
+    for (int i = 0; i < 4; ++i) {
+      const Vec3& c = m.load_c[l][i];
+      load_c[4 * l + i] = {{float(c[0]), float(c[1]), float(c[2]), 0.0f}};
+    }
+  }
   for (std::size_t t = 0; t < tets.size(); ++t) tets[t] = {{m.tets[t][0], m.tets[t][1], m.tets[t][2], m.tets[t][3]}};
-  tris_buf_ = upload(ctx, tris);
+  std::vector<float> fraction(std::max<std::size_t>(m.tets.size(), 1), 1.0f);
+  for (std::size_t t = 0; t < m.tet_fraction.size(); ++t) fraction[t] = float(m.tet_fraction[t]);
+  load_nodes_ = upload(ctx, load_nodes);
+  load_c_ = upload(ctx, load_c);
   tets_buf_ = upload(ctx, tets);
+  tet_fraction_ = upload(ctx, fraction);
   std::vector<float> mass(nodes_, 0.f);
   for (int64_t n = 0; n < nodes_ && !m.mass_kg.empty(); ++n) mass[n] = float(m.mass_kg[n]);
   mass_ = upload(ctx, mass);
@@ -192,13 +203,13 @@ ClForceEvaluator::ClForceEvaluator(ocl::Context& ctx, const Mesh& m, uint64_t ex
   f_ = upload(ctx, std::vector<cl_float4>(nodes_, cl_float4{{0, 0, 0, 0}}), CL_MEM_READ_WRITE);
   // One zero entry past the last element: the padding's target. Zeroed once, so a term that is
   // switched off also adds exact zeros.
-  tri_force_ = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, std::size_t(tris_ + 1) * sizeof(cl_float4));
+  load_force_ = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, std::size_t(4 * loads_ + 1) * sizeof(cl_float4));
   tet_force_ = cl::Buffer(ctx.context(), CL_MEM_READ_WRITE, std::size_t(4 * tets_ + 1) * sizeof(cl_float4));
-  ctx.queue().enqueueFillBuffer(tri_force_, cl_float4{{0, 0, 0, 0}}, 0, std::size_t(tris_ + 1) * sizeof(cl_float4));
+  ctx.queue().enqueueFillBuffer(load_force_, cl_float4{{0, 0, 0, 0}}, 0, std::size_t(4 * loads_ + 1) * sizeof(cl_float4));
   ctx.queue().enqueueFillBuffer(tet_force_, cl_float4{{0, 0, 0, 0}}, 0, std::size_t(4 * tets_ + 1) * sizeof(cl_float4));
 
   const std::string options = "-DW=" + std::to_string(kBlock);
-  k_tri_ = ctx.kernel("msd_forces.cl", "triangle_pressure", options);
+  k_load_ = ctx.kernel("msd_forces.cl", "load_pressure", options);
   k_tet_ = ctx.kernel("msd_forces.cl", "tet_volume", options);
   k_node_ = ctx.kernel("msd_forces.cl", "node_forces", options);
 }
@@ -222,20 +233,21 @@ void ClForceEvaluator::upload_state(const std::vector<Vec3>& x, const std::vecto
 
 void ClForceEvaluator::evaluate(const ForceModel& model, Nodes which) {
   auto& q = ctx_.queue();
-  const bool pressure = model.pressure_pa != 0.0 && tris_ > 0, volume = model.volume_stiffness_pa != 0.0;
+  const bool pressure = model.pressure_pa != 0.0 && loads_ > 0, volume = model.volume_stiffness_pa != 0.0;
   if (pressure) {
-    ocl::set_args(k_tri_, x_, rest_x_, tris_buf_, float(model.pressure_pa), cl_int(tris_), tri_force_);
-    q.enqueueNDRangeKernel(k_tri_, cl::NullRange, cl::NDRange(global_size(tris_)), cl::NDRange(kLocal));
+    ocl::set_args(k_load_, x_, rest_x_, load_nodes_, load_c_, float(model.pressure_pa), cl_int(loads_), load_force_);
+    q.enqueueNDRangeKernel(k_load_, cl::NullRange, cl::NDRange(global_size(loads_)), cl::NDRange(kLocal));
   }
   if (volume) {
-    ocl::set_args(k_tet_, x_, rest_x_, tets_buf_, float(model.volume_stiffness_pa), cl_int(tets_), tet_force_);
+    ocl::set_args(k_tet_, x_, rest_x_, tets_buf_, tet_fraction_, float(model.volume_stiffness_pa), cl_int(tets_),
+                  tet_force_);
     q.enqueueNDRangeKernel(k_tet_, cl::NullRange, cl::NDRange(global_size(tets_)), cl::NDRange(kLocal));
   }
   const int64_t blocks = which == Nodes::All ? blocks_ : free_blocks_;
   ocl::set_args(k_node_, x_, v_, mass_, cl_int(blocks), block_nodes_, spring_begin_, spring_node_, spring_k_,
                 spring_c_, spring_rest_[0], spring_rest_[1], spring_rest_[2], spring_rest_[3],
-                cl_int(model.spring_model == SpringModel::Linear), cl_int(model.damping), tri_force_, tri_begin_,
-                node_tri_, cl_int(pressure), tet_force_, tet_begin_, node_tet_, cl_int(volume),
+                cl_int(model.spring_model == SpringModel::Linear), cl_int(model.damping), load_force_, load_begin_,
+                node_load_, cl_int(pressure), tet_force_, tet_begin_, node_tet_, cl_int(volume),
                 cl_float4{{float(model.gravity_m_s2[0]), float(model.gravity_m_s2[1]), float(model.gravity_m_s2[2]), 0.0f}},
                 f_);
   if (blocks > 0)

@@ -42,14 +42,14 @@ class ClForceEvaluator {
 
  private:
   ocl::Context& ctx_;
-  int64_t nodes_, tris_, tets_, blocks_ = 0, free_blocks_ = 0;
+  int64_t nodes_, loads_, tets_, blocks_ = 0, free_blocks_ = 0;
   std::vector<int> spring_begin_host_;
   cl::Buffer x_, v_, rest_x_, mass_, f_;
   cl::Buffer block_nodes_, spring_begin_, spring_node_, spring_k_, spring_c_, spring_rest_[4];   // rest: x, y, z, length
-  cl::Buffer tris_buf_, tri_force_, tri_begin_, node_tri_;
+  cl::Buffer load_nodes_, load_c_, load_force_, load_begin_, node_load_, tet_fraction_;
   cl::Buffer tets_buf_, tet_force_, tet_begin_, node_tet_;
   std::vector<Vec3> rest_m_;
-  cl::Kernel k_tri_, k_tet_, k_node_;
+  cl::Kernel k_load_, k_tet_, k_node_;
 };
 
 /// float4 packing of node vectors (x, y, z, 0).

@@ -42,16 +42,11 @@ void check_solvable(const Mesh& m, const SolveOptions& opt, const std::string& w
   if (free_nodes == 0)
     throw InputError(what + ": every one of the mesh's " + std::to_string(N) +
                      " nodes is fixed, so nothing can move; fewer voxels must be fixed (roles.fixed_labels), or a "
-                     "smaller mesh.cube_voxels (a cube holding any fixed voxel fixes all its corners)");
+                     "smaller mesh.cube_voxels (a node is fixed where a fixed voxel touches it)");
 
-  // The load at rest, per node: pressure on the cavity triangles and gravity.
+  // The load at rest, per node: pressure on the cavity faces and gravity.
   const double pressure_pa = std::max(std::abs(opt.start_pressure_pa), std::abs(opt.forces.pressure_pa));
-  std::vector<Vec3> f(N, Vec3::Zero());
-  if (pressure_pa > 0.0)
-    for (const auto& t : m.cavity_tris) {
-      const Vec3 fv = pressure_force_per_vertex(m.rest_m[t[0]], m.rest_m[t[1]], m.rest_m[t[2]], pressure_pa);
-      for (int32_t n : t) f[n] += fv;
-    }
+  std::vector<Vec3> f = pressure_forces(m, m.rest_m, pressure_pa);
   if (opt.forces.gravity_m_s2.squaredNorm() > 0.0)
     for (int64_t n = 0; n < N; ++n) f[n] += m.mass_kg[n] * opt.forces.gravity_m_s2;
 

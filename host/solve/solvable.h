@@ -19,7 +19,7 @@ MeshComponents connected_components(const Mesh& m);
 
 /// Throws InputError when every node is held on every axis (nothing can move), or when a connected
 /// part of the mesh holds no node on an axis along which the load at rest (the larger of the start
-/// and target pressures on its cavity triangles, plus gravity) pushes it with a net force: a rigid
+/// and target pressures on its cavity faces, plus gravity) pushes it with a net force: a rigid
 /// drift, for which no equilibrium exists. Only translations are checked: a part held at a single
 /// point could still turn, but the lattice's fixed cubes hold four nodes or more wherever they
 /// touch a part. Parts with no held node and no net load (a closed cavity, Lamé's sphere) pass.

@@ -29,13 +29,11 @@ Vec3 node_force(const Mesh& m, const Adjacency& adj, const ForceModel& model, co
       const auto& q = m.tets[t];
       const double v0 = m.tet_rest_volume_m3[t];
       const double vol = signed_tet_volume(x[q[0]], x[q[1]], x[q[2]], x[q[3]]);
-      f += -model.volume_stiffness_pa * (vol - v0) / v0 * tet_volume_gradient(x[q[0]], x[q[1]], x[q[2]], x[q[3]])[slot];
+      f += -model.volume_stiffness_pa * m.tet_fraction[t] * (vol - v0) / v0 * tet_volume_gradient(x[q[0]], x[q[1]], x[q[2]], x[q[3]])[slot];
     }
   if (model.pressure_pa != 0.0)
-    for (int64_t e = adj.tris.begin(n); e < adj.tris.end(n); ++e) {
-      const auto& q = m.cavity_tris[adj.tris.item[e] / 8];
-      f += pressure_force_per_vertex(x[q[0]], x[q[1]], x[q[2]], model.pressure_pa);
-    }
+    for (int64_t e = adj.loads.begin(n); e < adj.loads.end(n); ++e)
+      f += pressure_load_forces(m, adj.loads.item[e] / 8, x, model.pressure_pa)[adj.loads.item[e] % 8];
   return f;
 }
 

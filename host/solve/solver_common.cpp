@@ -92,11 +92,7 @@ Monitor::Monitor(const Mesh& m, const SolveOptions& opt, const std::string& solv
   r.solver = solver;
   check_solvable(m, opt);   // nothing free, or a part the load would carry away: no solver can answer
   // Reference load: the pressure's largest nodal force at rest.
-  std::vector<Vec3> f(m.node_count(), Vec3::Zero());
-  for (const auto& t : m.cavity_tris) {
-    const Vec3 fv = pressure_force_per_vertex(m.rest_m[t[0]], m.rest_m[t[1]], m.rest_m[t[2]], opt.forces.pressure_pa);
-    for (int32_t n : t) f[n] += fv;
-  }
+  const std::vector<Vec3> f = pressure_forces(m, m.rest_m, opt.forces.pressure_pa);
   double ref = 0.0;
   for (const auto& v : f) ref = std::max(ref, v.norm());
   if (!(ref > 0.0)) {

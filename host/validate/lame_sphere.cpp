@@ -3,7 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
-#include <set>
+
 
 #include "core/units.h"
 #include "validate/validate.h"
@@ -52,7 +52,7 @@ PlacementMeans solve_placement(const LameOptions& o, const Vec3& offset_cubes) {
     for (int64_t j = 0; j < g.dims[1]; ++j)
       for (int64_t i = 0; i < g.dims[0]; ++i) {
         const double r = g.to_world(Vec3(i, j, k)).norm();
-        // Inside the cavity: "viscera" so that the wall's inner faces are cavity triangles.
+        // Inside the cavity: "viscera" so that the wall's inner voxel faces carry the pressure.
         roles[g.linear_index(i, j, k)] = r < o.inner_mm ? Role::Viscera : r <= o.outer_mm ? Role::Wall : Role::Other;
       }
   MeshOptions mo;
@@ -64,8 +64,8 @@ PlacementMeans solve_placement(const LameOptions& o, const Vec3& offset_cubes) {
   // Nothing is held: the pressure on the closed cavity has no net force, and a rigid drift has no
   // mean radial component over a closed surface.
 
-  // Boundary triangles from the mesh itself: tetrahedron faces used once; cavity triangles are the
-  // inner surface, the rest the outer. Each node's share of its boundary's area (⅓ per triangle)
+  // Boundary triangles from the mesh itself: tetrahedron faces used once; those nearer the cavity
+  // than the mid-radius are the inner surface, the rest the outer. Each node's share of its boundary's area (⅓ per triangle)
   // makes Σ A_i u_i / Σ A_i the exact surface mean of the piecewise-linear displacement.
   std::map<std::array<int32_t, 3>, int> face_uses;
   for (const auto& t : m.tets)
@@ -74,15 +74,12 @@ PlacementMeans solve_placement(const LameOptions& o, const Vec3& offset_cubes) {
       std::sort(key.begin(), key.end());
       ++face_uses[key];
     }
-  std::set<std::array<int32_t, 3>> cavity;
-  for (auto t : m.cavity_tris) {
-    std::sort(t.begin(), t.end());
-    cavity.insert(t);
-  }
+  const double mid_radius_m = units::mm_to_m(0.5 * (o.inner_mm + o.outer_mm));
   std::vector<double> area[2] = {std::vector<double>(m.node_count(), 0.0), std::vector<double>(m.node_count(), 0.0)};
   for (const auto& [key, uses] : face_uses) {
     if (uses != 1) continue;
-    const int s = cavity.count(key) ? 0 : 1;
+    const double r = ((m.rest_m[key[0]] + m.rest_m[key[1]] + m.rest_m[key[2]]) / 3.0).norm();
+    const int s = r < mid_radius_m ? 0 : 1;
     const double A = 0.5 * (m.rest_m[key[1]] - m.rest_m[key[0]]).cross(m.rest_m[key[2]] - m.rest_m[key[0]]).norm();
     for (int32_t n : key) area[s][n] += A / 3.0;
   }

@@ -1,0 +1,42 @@
+// The gas pressure on the embedded cavity faces (mesh.h; method.md §5) and the volume they enclose.
+#include "mesh/mesh.h"
+
+namespace pneumo {
+
+namespace {
+/// cof(D_s)·c for the edges e_k = x_k − x_0: c.x (e2×e3) + c.y (e3×e1) + c.z (e1×e2).
+Vec3 cofactor_times(const Vec3& e1, const Vec3& e2, const Vec3& e3, const Vec3& c) {
+  return c[0] * e2.cross(e3) + c[1] * e3.cross(e1) + c[2] * e1.cross(e2);
+}
+}  // namespace
+
+std::array<Vec3, 4> pressure_load_forces(const Mesh& m, int64_t l, const std::vector<Vec3>& x, double pressure_pa) {
+  const auto& q = m.tets[m.load_tet[l]];
+  const Vec3 e1 = x[q[1]] - x[q[0]], e2 = x[q[2]] - x[q[0]], e3 = x[q[3]] - x[q[0]];
+  std::array<Vec3, 4> f;
+  for (int i = 0; i < 4; ++i) f[i] = -pressure_pa * cofactor_times(e1, e2, e3, m.load_c[l][i]);
+  return f;
+}
+
+double enclosed_cavity_volume(const Mesh& m, const std::vector<Vec3>& x, const Vec3& origin) {
+  // Σ_faces x_f · n da = Σ_i x_i · cof(F) B_i = Σ_i x_i · cof(D_s) c_i (the weights are linear).
+  double v = 0.0;
+  for (std::size_t l = 0; l < m.load_tet.size(); ++l) {
+    const auto& q = m.tets[m.load_tet[l]];
+    const Vec3 e1 = x[q[1]] - x[q[0]], e2 = x[q[2]] - x[q[0]], e3 = x[q[3]] - x[q[0]];
+    for (int i = 0; i < 4; ++i) v -= (x[q[i]] - origin).dot(cofactor_times(e1, e2, e3, m.load_c[l][i])) / 3.0;
+  }
+  return v;
+}
+
+std::vector<Vec3> pressure_forces(const Mesh& m, const std::vector<Vec3>& x, double pressure_pa) {
+  std::vector<Vec3> f(x.size(), Vec3::Zero());
+  for (std::size_t l = 0; l < m.load_tet.size(); ++l) {
+    const auto fl = pressure_load_forces(m, int64_t(l), x, pressure_pa);
+    const auto& q = m.tets[m.load_tet[l]];
+    for (int i = 0; i < 4; ++i) f[q[i]] += fl[i];
+  }
+  return f;
+}
+
+}  // namespace pneumo
