@@ -14,6 +14,7 @@
 #include "io/volume_io.h"
 #include "report/png.h"
 #include "report/slices.h"
+#include "roles/connected_components.h"
 
 namespace pneumo {
 
@@ -162,6 +163,16 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
   nlohmann::json j;
   j["cavity_voxels"] = w.cavity_voxels();
   j["cavity_volume_ml"] = w.cavity_volume_ml();
+  // The gas should be one connected cavity (issue "A human answer"): the share of it outside its
+  // largest 6-connected piece shows specks and pockets that opened apart from it.
+  if (!w.result.labels.empty()) {
+    std::vector<uint8_t> gas(w.result.labels.size());
+    for (std::size_t n = 0; n < gas.size(); ++n) gas[n] = w.result.labels[n] == uint16_t(scene.output.cavity_label);
+    const int64_t largest = keep_largest_component(gas, w.ct.geometry().dims);
+    j["cavity_largest_piece_ml"] = double(largest) * w.voxel_volume_ml;
+    j["cavity_outside_largest_piece_fraction"] =
+        w.cavity_voxels() > 0 ? 1.0 - double(largest) / double(w.cavity_voxels()) : 0.0;
+  }
   j["warp"] = {{"device", w.result.device},
                {"cavity_label", scene.output.cavity_label},
                {"carried_voxels", w.result.carried_voxels},
