@@ -480,5 +480,33 @@ TEST(MeshErrors, NothingToMeshThrowsInputError) {
   EXPECT_THROW(build(fixed_only, 1, MeshModel::WallViscera), InputError);
 }
 
+TEST(MeshTissue, ModulusIsTheVolumeAverageOfTheVoxels) {
+  // Compared: one cube of 4×4×4 wall voxels (L = 4) whose lower half is fat (HU −100 → 2 kPa) and upper half
+  // muscle (HU +50 → 60 kPa), against the volume average: Σ_t E_t V_t = ½ (2 + 60) kPa × V, within the
+  // sampling of the tetrahedra (voxel centres: the central one is oversampled, 1 %); all fat gives 2 kPa in
+  // every tetrahedron exactly, and the modulus by label alone (no CT) 60 kPa.
+  Voxels v(4, 4, 4, 1.0, Role::Wall);
+  std::vector<float> hu(v.roles.size());
+  for (int64_t k = 0; k < 4; ++k)
+    for (int64_t j = 0; j < 4; ++j)
+      for (int64_t i = 0; i < 4; ++i) hu[v.g.linear_index(i, j, k)] = k < 2 ? -100.0f : 50.0f;
+  const VoxelYoungFn young = [](Role, int, float h) { return h <= -30.0f ? 2e3 : 60e3; };
+  MeshOptions o;
+  o.cube_voxels = 4;
+  o.model = MeshModel::Wall;
+  const Mesh half = build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}, o, young);
+  double ev = 0.0, vol = 0.0;
+  for (std::size_t t = 0; t < half.tets.size(); ++t) {
+    ev += half.tet_young_pa[t] * half.tet_rest_volume_m3[t];
+    vol += half.tet_rest_volume_m3[t];
+  }
+  EXPECT_NEAR(ev / vol, 31e3, 0.01 * 31e3);
+  std::fill(hu.begin(), hu.end(), -100.0f);
+  const Mesh fat = build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}, o, young);
+  for (double e : fat.tet_young_pa) EXPECT_DOUBLE_EQ(e, 2e3);
+  const Mesh no_ct = build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr}, o, young);
+  for (double e : no_ct.tet_young_pa) EXPECT_DOUBLE_EQ(e, 60e3);
+}
+
 }  // namespace
 }  // namespace pneumo

@@ -454,6 +454,15 @@ TEST(SceneRules, Queries) {
   EXPECT_EQ(s.young_kpa_for(Role::Wall, 2), 24.0);
   EXPECT_EQ(s.young_kpa_for(Role::Viscera, 5), 50.0);
   EXPECT_EQ(s.young_kpa_for(Role::Viscera, 6), 3.0);
+  // Fat by HU: off by default; on, inside [-190, -30] HU (ends included) unless the label has its own E.
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 2, -100.0f), 24.0);
+  s.material.fat_young_kpa = 2.0;
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 2, -100.0f), 2.0);
+  EXPECT_EQ(s.young_kpa_for(Role::Viscera, 5, -190.0f), 2.0);
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 2, -30.0f), 2.0);
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 2, -29.0f), 24.0);
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 2, -191.0f), 24.0);
+  EXPECT_EQ(s.young_kpa_for(Role::Viscera, 6, -100.0f), 3.0);
   EXPECT_EQ(s.effective_volume_stiffness_kpa(), 0.0);
   s.solver.method = SolverMethod::Kitasaka2004;
   EXPECT_EQ(s.effective_volume_stiffness_kpa(), 50.0);

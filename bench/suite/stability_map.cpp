@@ -68,7 +68,7 @@ json measure_stability_map(BenchContext& ctx) {
       scene.material.wall_young_kpa.reset();
       scene.material.viscera_young_kpa.reset();
       scene.material.label_young_kpa.clear();
-      const Mesh mesh = build_scene_mesh(VoxelRoles{c.roles.geometry, c.roles.role.data(), c.roles.label.data()},
+      const Mesh mesh = build_scene_mesh(VoxelRoles{c.roles.geometry, c.roles.role.data(), c.roles.label.data(), c.roles.hu()},
                                          scene);
       for (const SolverMethod method : {SolverMethod::Explicit, SolverMethod::Newmark}) {
         scene.solver.method = method;

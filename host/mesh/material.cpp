@@ -39,7 +39,8 @@ Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene) {
   opt.model = scene.mesh.model;
   opt.roi_min_mm = scene.mesh.roi_min_mm;
   opt.roi_max_mm = scene.mesh.roi_max_mm;
-  Mesh m = build_mesh(roles, opt, [&](Role r, int label) { return scene.young_kpa_for(r, label) * 1e3; });
+  Mesh m = build_mesh(roles, opt,
+                      VoxelYoungFn([&](Role r, int label, float hu) { return scene.young_kpa_for(r, label, hu) * 1e3; }));
   MaterialOptions mat;
   mat.density_kg_m3 = scene.material.density_kg_m3;
   mat.damping_ratio = scene.material.damping_ratio;

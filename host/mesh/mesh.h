@@ -38,7 +38,11 @@ struct VoxelRoles {
   Geometry geometry;
   const Role* role = nullptr;       // voxel_count() entries
   const uint16_t* label = nullptr;  // optional: organ labels for per-label Young's modulus
+  const float* hu = nullptr;        // optional: the CT (HU), for moduli by tissue density (fat)
 };
+
+/// Young's modulus (Pa) of one voxel of tissue: its role, label (0 when none) and HU (0 without a CT).
+using VoxelYoungFn = std::function<double(Role, int label, float hu)>;
 
 /// The smallest share of a tetrahedron's volume counted as its tissue: tetrahedra of a meshed cube
 /// that hold (almost) none of their part's tissue keep this fraction of its stiffness and mass, so
@@ -105,8 +109,10 @@ struct Mesh {
 };
 
 /// Builds the mesh from voxel roles (§3). Throws InputError when nothing would be meshed.
-/// Young's modulus per tetrahedron is the average of `young_pa_for(role, label)` over the points
-/// of it that hold its part's tissue (0 elsewhere).
+/// Young's modulus per tetrahedron is the average of `young_pa_for(role, label, hu)` over its points
+/// (0 where they hold no tissue of its part).
+Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoungFn& young_pa_for);
+/// The same with a modulus by role and label only.
 Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const std::function<double(Role, int)>& young_pa_for);
 
 /// u = x − x₀ per node (metres): what deformation.bin, checkpoints and the warp carry.

@@ -41,21 +41,16 @@ struct Lattice {
 int samples_per_voxel(int L) { return std::max(1, (4 + L - 1) / L); }
 
 /// Per cube: which roles its voxels hold, each part's dominant label, and per part and tetrahedron
-/// (cube_tets order) how many sample points hold the part's tissue, with their labels.
+/// (cube_tets order) how many sample points hold the part's tissue and the sum of their moduli.
 struct CubeContent {
   bool has[4] = {false, false, false, false};   // indexed by Role
   uint16_t label[kParts] = {0, 0};
-  // (label, samples) of part p's tissue in tetrahedron k.
-  std::vector<std::pair<uint16_t, int32_t>> tissue[kParts][5];
+  int32_t tissue[kParts][5] = {{0, 0, 0, 0, 0}, {0, 0, 0, 0, 0}};
+  double young_sum[kParts][5] = {{0, 0, 0, 0, 0}, {0, 0, 0, 0, 0}};
 };
 
-void add_sample(std::vector<std::pair<uint16_t, int32_t>>& v, uint16_t label) {
-  for (auto& e : v)
-    if (e.first == label) { ++e.second; return; }
-  v.emplace_back(label, 1);
-}
-
-std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& lat, int L) {
+std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& lat, int L,
+                                        const VoxelYoungFn& young_pa_for) {
   const Geometry& g = roles.geometry;
   const int s = samples_per_voxel(L);
   std::vector<CubeContent> out(lat.cubes[0] * lat.cubes[1] * lat.cubes[2]);
@@ -76,6 +71,7 @@ std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& 
               const int p = r == Role::Wall ? 0 : 1;
               const uint16_t id = roles.label ? roles.label[v] : 0;
               ++counts[p][id];
+              const double young = young_pa_for(r, id, roles.hu ? roles.hu[v] : 0.0f);
               // The voxel's sample points, in the cube's local coordinates u ∈ [0,1]³.
               for (int mz = 0; mz < s; ++mz)
                 for (int my = 0; my < s; ++my)
@@ -83,7 +79,9 @@ std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& 
                     const std::array<double, 3> u{(double(i - a * L) + (mx + 0.5) / s) / L,
                                                   (double(j - b * L) + (my + 0.5) / s) / L,
                                                   (double(k - c * L) + (mz + 0.5) / s) / L};
-                    add_sample(cc.tissue[p][lattice::tet_holding(u, odd)], id);
+                    const int kt = lattice::tet_holding(u, odd);
+                    ++cc.tissue[p][kt];
+                    cc.young_sum[p][kt] += young;
                   }
             }
         for (int p = 0; p < kParts; ++p) {
@@ -91,7 +89,7 @@ std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& 
           for (auto [id, n] : counts[p])
             if (n > best) { best = n; cc.label[p] = id; }
         }
-        out[lat.cube_index(a, b, c)] = std::move(cc);
+        out[lat.cube_index(a, b, c)] = cc;
       }
   return out;
 }
@@ -227,15 +225,18 @@ void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
 
 }  // namespace
 
-Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt,
-                const std::function<double(Role, int)>& young_pa_for) {
+Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const std::function<double(Role, int)>& young_pa_for) {
+  return build_mesh(roles, opt, VoxelYoungFn([&](Role r, int label, float) { return young_pa_for(r, label); }));
+}
+
+Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoungFn& young_pa_for) {
   const Geometry& g = roles.geometry;
   const int L = opt.cube_voxels;
   if (L < 1) throw InputError("mesh.cube_voxels must be at least 1");
   Lattice lat;
   for (int a = 0; a < 3; ++a) lat.cubes[a] = (g.dims[a] + L - 1) / L;
 
-  const std::vector<CubeContent> content = classify_cubes(roles, lat, L);
+  const std::vector<CubeContent> content = classify_cubes(roles, lat, L, young_pa_for);
   const std::array<int64_t, 5> tet_samples = samples_per_tet(L);
   const bool with_viscera = opt.model == MeshModel::WallViscera;
 
@@ -294,7 +295,7 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt,
           }
           const Role role = p == 0 ? Role::Wall : Role::Viscera;
           const uint16_t label = content[q].label[p];
-          const double floor_young = kMinTissueFraction * young_pa_for(role, label);
+          const double floor_young = kMinTissueFraction * young_pa_for(role, label, 0.0f);
           first_tet[p][q] = int32_t(m.tets.size());
           const auto tets = lattice::cube_tets(odd);
           for (int k = 0; k < 5; ++k) {
@@ -304,12 +305,8 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt,
             if (vol < 0) { std::swap(tet[2], tet[3]); vol = -vol; }
             // The volume average of the modulus over the tetrahedron, tissue of the part counted
             // with its own modulus and anything else (air, bone, the other part) with none.
-            double young_sum = 0.0;
-            int64_t tissue = 0;
-            for (auto [id, n] : content[q].tissue[p][k]) {
-              young_sum += double(n) * young_pa_for(role, id);
-              tissue += n;
-            }
+            const double young_sum = content[q].young_sum[p][k];
+            const int64_t tissue = content[q].tissue[p][k];
             const double total = double(tet_samples[k]);
             m.tets.push_back(tet);
             m.tet_part.push_back(Part(p));

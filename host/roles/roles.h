@@ -21,6 +21,12 @@ struct RoleVolume {
   Volume ct;                    // the CT on the same grid, float32 HU (padding -1000)
 
   int64_t count(Role r) const;
+  /// The CT's HU per voxel, or null when it holds none on this grid.
+  const float* hu() const {
+    return ct.type() == VoxelType::Float32 && ct.voxel_count() == int64_t(role.size()) && !role.empty()
+               ? ct.data<float>()
+               : nullptr;
+  }
   double voxel_volume_ml() const;   // spacing product / 1000
   double volume_ml(Role r) const { return double(count(r)) * voxel_volume_ml(); }
 };

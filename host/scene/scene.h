@@ -116,6 +116,10 @@ struct SceneMaterial {
   double young_kpa = 60.0;        // Nimura (§4)
   std::optional<double> wall_young_kpa, viscera_young_kpa;
   std::vector<LabelYoung> label_young_kpa;
+  // Fat by density: wall and viscera voxels whose HU lies in [fat_hu_min, fat_hu_max] (the adipose
+  // window of CT body-composition studies) take fat_young_kpa unless their label has its own value.
+  std::optional<double> fat_young_kpa;
+  double fat_hu_min = -190.0, fat_hu_max = -30.0;
   double damping_ratio = 0.4;     // ζ, Nimura (§4)
   double spring_scale = 1.0;      // as published; 0.925 matches the lattice to E (§4)
   SpringModel spring_model = SpringModel::Nonlinear;  // rotation-invariant (§5)
@@ -263,6 +267,8 @@ struct Scene {
   /// Young's modulus of a tetrahedron (kPa): label_young_kpa for its label, else the role's
   /// override (wall_young_kpa, viscera_young_kpa), else young_kpa.
   double young_kpa_for(Role role, int label) const;
+  /// The same for one voxel of HU `hu`: fat_young_kpa inside the fat window (docs/fidelity.md).
+  double young_kpa_for(Role role, int label, float hu) const;
 
   /// Kitasaka's k_v (kPa): volume_stiffness_kpa when set; unset: young_kpa for kitasaka2004
   /// (the 2004 scheme needs it: its springs alone let tetrahedra collapse), 0 for the others.

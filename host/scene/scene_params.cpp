@@ -149,6 +149,11 @@ const Table<SceneMaterial>& material_table() {
        "E of viscera tetrahedra; unset = young_kpa (Bano: 15)."},
       {"label_young_kpa", &SceneMaterial::label_young_kpa, label_young_table(), any(),
        "E per label id, over the role's value: [{\"label\": 5, \"young_kpa\": 3}]."},
+      {"fat_young_kpa", &SceneMaterial::fat_young_kpa, "kPa", above(0, kMaxKPa),
+       "E of wall and viscera voxels in the fat window [fat_hu_min, fat_hu_max] unless their label has one; "
+       "unset = off (their role's E). Fat is far softer than muscle: 1-3 kPa (docs/fidelity.md)."},
+      {"fat_hu_min", &SceneMaterial::fat_hu_min, "HU", in(-1024, 3071), "Lower end of the fat window (-190)."},
+      {"fat_hu_max", &SceneMaterial::fat_hu_max, "HU", in(-1024, 3071), "Upper end of the fat window (-30)."},
       {"damping_ratio", &SceneMaterial::damping_ratio, "", in(0, 10),
        "ζ: each spring's damper c = 2ζ√(m k) (§4; Nimura 0.4)."},
       {"spring_scale", &SceneMaterial::spring_scale, "", above(0, 10),

@@ -30,6 +30,13 @@ double Scene::young_kpa_for(Role role, int label) const {
   return material.young_kpa;
 }
 
+double Scene::young_kpa_for(Role role, int label, float hu) const {
+  for (const LabelYoung& l : material.label_young_kpa)
+    if (l.label == label) return l.young_kpa;
+  if (material.fat_young_kpa && hu >= material.fat_hu_min && hu <= material.fat_hu_max) return *material.fat_young_kpa;
+  return young_kpa_for(role, label);
+}
+
 double Scene::effective_volume_stiffness_kpa() const {
   if (material.volume_stiffness_kpa) return *material.volume_stiffness_kpa;
   // Kitasaka gives no value for k_v. k_v = E adds E to the lattice's bulk modulus (0.721 E, shear
