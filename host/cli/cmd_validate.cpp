@@ -3,6 +3,7 @@
 #include "cli/commands.h"
 #include "core/error.h"
 #include "pipeline/convergence_study.h"
+#include "pipeline/pressure_volume_study.h"
 #include "validate/validate.h"
 
 namespace pneumo::cli {
@@ -16,6 +17,7 @@ Run add_validate(CLI::App& app) {
     LameOptions lame;
     std::string scene;
     std::vector<int> cube_voxels{4, 3, 2, 1};
+    std::vector<double> pressures = default_pressure_volume_pressures();
   };
   auto o = std::make_shared<Opts>();
   auto* lattice = cmd->add_subcommand("lattice", "Effective Young's modulus of the cube lattice along an axis (method.md §4: 1.140·E)");
@@ -33,7 +35,29 @@ Run add_validate(CLI::App& app) {
       ->delimiter(',')
       ->capture_default_str();
   conv->add_flag("--json", o->json, "Print JSON (rows, observed_order and extrapolated value per quantity)");
+  auto* pv = cmd->add_subcommand("pressure-volume",
+                                 "The cavity volume against pressure: compliance and the share of the 30 mmHg volume at 15");
+  pv->add_option("scene", o->scene, "Scene .json")->required();
+  pv->add_option("--pressures-mmhg", o->pressures, "Pressures, each solved from the last equilibrium (must hold 5, 15, 30)")
+      ->delimiter(',')
+      ->capture_default_str();
+  pv->add_flag("--json", o->json, "Print JSON (curve, compliance_ml_per_mmhg, fraction_of_30_at_15)");
   return [=] {
+    if (pv->parsed()) {
+      const PressureVolumeStudy s = pressure_volume_study(load_scene(o->scene), o->pressures);
+      if (o->json) {
+        std::cout << to_json(s).dump(2) << "\n";
+        return 0;
+      }
+      std::printf("%-14s %-12s %-10s %s\n", "pressure_mmhg", "cavity_ml", "rise_mm", "converged");
+      for (const PressurePoint& p : s.curve)
+        std::printf("%-14.1f %-12.1f %-10.2f %s\n", p.pressure_mmhg, p.cavity_volume_ml, p.anterior_rise_mm,
+                    p.converged ? "yes" : "no");
+      std::printf("compliance 5-15 mmHg: %.1f ml/mmHg; V(15)/V(30) = %.2f (patients about 0.67, McDougall 1994; a "
+                  "linear wall 0.5)\n",
+                  s.compliance_ml_per_mmhg, s.fraction_of_30_at_15);
+      return s.all_converged ? 0 : 1;
+    }
     if (conv->parsed()) {
       const ConvergenceStudy s = convergence_study(load_scene(o->scene), o->cube_voxels);
       if (o->json) {
