@@ -15,6 +15,7 @@
 #include "report/png.h"
 #include "report/slices.h"
 #include "roles/connected_components.h"
+#include "warp/cavity_specks.h"
 
 namespace pneumo {
 
@@ -123,9 +124,11 @@ WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labe
   opt.cavity_label = cavity;
   const auto t0 = std::chrono::steady_clock::now();
   w.result = warp_on_device(scene.device, w.warp_mesh, src, box, opt);
-  w.seconds_warp = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const Vec3& s = w.ct.geometry().spacing_mm;
   w.voxel_volume_ml = s[0] * s[1] * s[2] / 1000.0;
+  const int64_t min_voxels = int64_t(std::ceil(scene.output.min_cavity_piece_ml / w.voxel_volume_ml));
+  w.specks = fill_cavity_specks(w.result, box.dims, min_voxels);
+  w.seconds_warp = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   w.cavity_centroid_mm = cavity_centroid(w.result, w.ct.geometry());
   return w;
 }
@@ -170,6 +173,8 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
     for (std::size_t n = 0; n < gas.size(); ++n) gas[n] = w.result.labels[n] == uint16_t(scene.output.cavity_label);
     const int64_t largest = keep_largest_component(gas, w.ct.geometry().dims);
     j["cavity_largest_piece_ml"] = double(largest) * w.voxel_volume_ml;
+    j["cavity_specks_filled"] = {{"pieces", w.specks.pieces}, {"voxels", w.specks.voxels},
+                                 {"below_ml", scene.output.min_cavity_piece_ml}};
     j["cavity_outside_largest_piece_fraction"] =
         w.cavity_voxels() > 0 ? 1.0 - double(largest) / double(w.cavity_voxels()) : 0.0;
   }

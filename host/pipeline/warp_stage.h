@@ -13,6 +13,7 @@
 #include "mesh/mesh.h"
 #include "roles/roles.h"
 #include "scene/scene.h"
+#include "warp/cavity_specks.h"
 #include "warp/point_map.h"
 #include "warp/warp.h"
 
@@ -29,6 +30,7 @@ struct WarpedCase {
   double voxel_volume_ml = 0.0;
   std::optional<Vec3> cavity_centroid_mm;   // none when no voxel became gas
   double seconds_warp = 0.0;
+  SpeckFill specks;               // gas pieces below output.min_cavity_piece_ml, filled
 
   int64_t cavity_voxels() const { return result.gas_voxels; }
   double cavity_volume_ml() const { return double(result.gas_voxels) * voxel_volume_ml; }

@@ -221,6 +221,9 @@ struct SceneOutput {
   // Label id of the CO2 cavity in the warped label map (§7). TotalSegmentator's ids end at 117 and
   // the phantom's own at 207; 250 is free in both. A label map that already uses it is refused.
   int cavity_label = 250;
+  // Gas pieces smaller than this are cracks between the two meshes, not cavity: filled from their
+  // surroundings (warp/cavity_specks.h). 0 keeps every piece.
+  double min_cavity_piece_ml = 1.0;
   bool write_slices = true;
   bool write_depth = false;
   int64_t timelapse_every_steps = 0;  // 0 = off

@@ -328,6 +328,9 @@ const Table<SceneOutput>& output_table() {
        "Write the warped label map (with the cavity label) when a label map is given (§7)."},
       {"cavity_label", &SceneOutput::cavity_label, "", in(1, 65535),
        "Label id of the CO2 cavity in the warped label map (§7); must not be an id the label map uses."},
+      {"min_cavity_piece_ml", &SceneOutput::min_cavity_piece_ml, "ml", in(0, 1e6),
+       "Gas pieces (6-connected) smaller than this are cracks between the wall's and the viscera's "
+       "tetrahedra, not CO2: filled with their neighbours' HU and labels; 0 keeps every piece."},
       {"write_slices", &SceneOutput::write_slices, "", any(), "Write before/after slice pairs (axial, coronal, sagittal)."},
       {"write_depth", &SceneOutput::write_depth, "", any(), "Write a depth map beside each view."},
       {"timelapse_every_steps", &SceneOutput::timelapse_every_steps, "", in(0, 1e9),
