@@ -270,3 +270,27 @@ TEST(RolesAuto, FindsThePhantomsWallWithoutWallLabels) {
     EXPECT_GT(recall, 0.9);
   }
 }
+
+TEST(RolesAuto, TissueInFrontOfThePrevesicalLabelsJoinsTheWall) {
+  // Compared: the torso with a "bladder" (label 21, a 12 mm sphere at x = 0, y = −10 mm, listed as wall)
+  // and roles.auto_prevesical_labels = [21], against rule 5b: the core tissue anterior to the sphere in its
+  // own columns (x = 0, y = 30 mm: between it and the shell) becomes wall; the same tissue beside the sphere's
+  // columns (x = 40 mm) and behind it (y = −40 mm) stays viscera; without the key it is all viscera.
+  Progress::set_enabled(false);
+  const Volume ct = torso(kIso);
+  Volume labels(kIso, VoxelType::UInt8);
+  for (int64_t n = 0; n < kIso.voxel_count(); ++n) {
+    const Vec3 w = kIso.to_world(Vec3(n % 81, (n / 81) % 57, n / (81 * 57)));
+    if ((w - Vec3(0, -10, 22.5)).norm() <= 12) labels.data<uint8_t>()[n] = 21;
+  }
+  Scene s = auto_scene();
+  s.roles.wall_labels = {21};
+  const RoleVolume without = assign_roles(s, ct, &labels);
+  s.roles.auto_prevesical_labels = {21};
+  const RoleVolume with = assign_roles(s, ct, &labels);
+  EXPECT_EQ(role_at(without, {0, 30, 22.5}), Role::Viscera);
+  EXPECT_EQ(role_at(with, {0, 30, 22.5}), Role::Wall);
+  EXPECT_EQ(role_at(with, {40, 30, 22.5}), Role::Viscera);
+  EXPECT_EQ(role_at(with, {0, -40, 22.5}), role_at(without, {0, -40, 22.5}));
+  EXPECT_EQ(role_at(with, {0, -10, 22.5}), Role::Wall);   // the sphere itself, by its label
+}

@@ -1,5 +1,6 @@
 #include "roles/auto_roles.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -106,6 +107,25 @@ void assign_the_shell(std::vector<Role>& role, const std::vector<uint8_t>& body,
   }
 }
 
+/// Rule 5b: undecided voxels anterior to a prevesical label in the same axial column → wall.
+void attach_prevesical_space(std::vector<Role>& role, const uint16_t* label, const SliceFrame& f, const SceneRoles& r) {
+  if (!label || r.auto_prevesical_labels.empty()) return;
+  std::vector<uint8_t> listed(65536, 0);
+  for (int id : r.auto_prevesical_labels) listed[std::size_t(id)] = 1;
+#pragma omp parallel for schedule(static)
+  for (int64_t s = 0; s < f.n_si; ++s)
+    for (int64_t l = 0; l < f.n_lat; ++l) {
+      int64_t front = -1;   // anteriority of the column's most anterior listed voxel
+      for (int64_t a = 0; a < f.n_ap; ++a)
+        if (listed[label[f.index(l, a, s)]]) front = std::max(front, f.ant(a));
+      if (front < 0) continue;
+      for (int64_t a = 0; a < f.n_ap; ++a) {
+        const int64_t v = f.index(l, a, s);
+        if (f.ant(a) > front && role[v] == kUndecided) role[v] = Role::Wall;
+      }
+    }
+}
+
 /// Rule 6: undecided voxels lateral to bone (away from the midline) → fixed.
 void fix_lateral_to_bone(std::vector<Role>& role, const std::vector<uint8_t>& body, const float* hu,
                          const std::vector<SliceCentre>& centres, const SliceFrame& f, const SceneRoles& r) {
@@ -141,6 +161,7 @@ std::vector<Role> auto_roles(const SceneRoles& r, const Geometry& g, const float
   timer.done(3, "back");
 
   assign_the_shell(role, body, centres, f, g, r);
+  if (r.auto_use_labels) attach_prevesical_space(role, label, f, r);
   timer.done(4, "wall shell");
 
   fix_lateral_to_bone(role, body, hu, centres, f, r);

@@ -11,6 +11,10 @@
 //   5. the shell: within auto_wall_thickness_mm of the body's surface (3-D Euclidean distance in mm,
 //      spacing respected) → wall where the direction from the slice's body centroid is within
 //      auto_wall_max_angle_deg of anterior, fixed beyond (the back lying on the table);
+//   5b. with auto_use_labels and a label map: undecided tissue anterior to a voxel of
+//      auto_prevesical_labels in the same axial column (same slice, same lateral position) → wall:
+//      the space of Retzius between the bladder and the wall is extraperitoneal, so no gas opens
+//      in front of the bladder (docs/fidelity.md);
 //   6. deeper tissue lateral to bone that is at least 40 mm from the midline (hip joints, iliac
 //      wings, pubic rami: the gluteal, hip and thigh muscles) → fixed (lateral_to_bone.h);
 //   7. everything else in the body → viscera.

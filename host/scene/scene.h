@@ -94,6 +94,10 @@ struct SceneRoles {
   double auto_wall_thickness_mm = 30.0;    // skin + fat + muscle of an adult abdomen
   double auto_wall_max_angle_deg = 100.0;  // anterior (0) and lateral (90) sides; the back is not
   bool auto_use_labels = true;
+  // Extraperitoneal organs whose front the peritoneum does not reach (the bladder: the space of
+  // Retzius lies between it and the wall): undecided tissue anterior to them in the same axial
+  // column becomes wall, so no gas opens there (auto_roles.h, rule 5b).
+  std::vector<int> auto_prevesical_labels;
   // Air added around the CT so the wall has room to rise (a 12 mmHg abdomen rises 30-60 mm).
   double pad_anterior_mm = 0.0, pad_lateral_mm = 0.0, pad_superior_mm = 0.0, pad_inferior_mm = 0.0;
 };

@@ -102,6 +102,10 @@ const Table<SceneRoles>& roles_table() {
        "the rest of the shell (the back, on the table) is fixed, the body inside it viscera."},
       {"auto_use_labels", &SceneRoles::auto_use_labels, "", any(),
        "auto with a label map: voxels whose label is in a role list keep that role; HU rules fill in the rest."},
+      {"auto_prevesical_labels", &SceneRoles::auto_prevesical_labels, "", ids,
+       "auto with a label map: undecided tissue anterior to these labels in the same axial column becomes wall "
+       "(the space of Retzius in front of the bladder is extraperitoneal: no gas opens there). TotalSegmentator: "
+       "[21]."},
       {"pad_anterior_mm", &SceneRoles::pad_anterior_mm, "mm", pad,
        "Air added in front of the CT so the wall has room to rise (a real CT cropped at the skin needs >= 60)."},
       {"pad_lateral_mm", &SceneRoles::pad_lateral_mm, "mm", pad,
