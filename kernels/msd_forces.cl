@@ -100,7 +100,7 @@ __kernel void node_forces(__global const float4* restrict u, __global const floa
                           __global const float* restrict spring_k, __global const float* restrict spring_c,
                           __global const float* restrict rest_x, __global const float* restrict rest_y,
                           __global const float* restrict rest_z, __global const float* restrict rest_len,
-                          const int linear_springs, const int damping,
+                          const int linear_springs, const int damping, const float stiffening,
                           __global const float4* restrict load_force, __global const int* restrict load_begin,
                           __global const int* restrict node_load, const int with_loads,
                           __global const float4* restrict tet_force, __global const int* restrict tet_begin,
@@ -143,7 +143,13 @@ __kernel void node_forces(__global const float4* restrict u, __global const floa
       // A zero-length spring has no direction and gives no force (as the CPU reference): e = 0.
       const floatW inv = select((floatW)(0.0f), 1.0f / len, isgreater(len, (floatW)(0.0f)));
       const floatW ex = dx * inv, ey = dy * inv, ez = dz * inv;
-      const floatW s = -k * (len - vloadW(r, rest_len)) - c * (dvx * ex + dvy * ey + dvz * ez);
+      const floatW l0 = vloadW(r, rest_len);
+      floatW stretch = len - l0;
+      if (stiffening > 0.0f) {   // k·l₀·(e^{bε} − 1)/b in tension (host/solve/forces.h)
+        const floatW stiff = l0 * expm1(stiffening * stretch / l0) / stiffening;
+        stretch = select(stretch, stiff, isgreater(stretch, (floatW)(0.0f)));
+      }
+      const floatW s = -k * stretch - c * (dvx * ex + dvy * ey + dvz * ez);
       fx += s * ex;
       fy += s * ey;
       fz += s * ez;

@@ -322,6 +322,49 @@ TEST(ForcesSprings, SpringForceIsMinusGradientOfItsEnergy) {
   }
 }
 
+TEST(ForcesSprings, StiffeningSpringsAreMinusTheGradientOfTheirEnergyAndKeepTheSmallStrainStiffness) {
+  // Compared, for the strain-stiffening law (b = 10, forces.h):
+  //  (1) the forces at randomly perturbed positions (±0.1 h, seeded) against −∂E/∂x_i by central differences
+  //      of E = Σ k l₀² G(ε): the same truncation argument as the plain springs (δ = 1e-4 h), tolerance 1e-6 of
+  //      the largest nodal force;
+  //  (2) one spring stretched by 1e-6 l₀ against the plain spring: the same force within 1e-5 (g'(0) = 1, the
+  //      next term is bε/2 = 5e-6), and compressed by 0.1 l₀: exactly the plain spring's (compression is
+  //      linear); stretched by 0.1 l₀: (e − 1)/(10·0.1) ≈ 1.718 times the plain spring's, to rounding;
+  //  (3) a rigid rotation by 1 rad: zero force (the law depends on |d| only), 1e-12 of k·h.
+  const Mesh m = enclosed_block(3);
+  const double h = units::mm_to_m(kSpacingMm), b = 10.0;
+  std::mt19937 rng(kSeed + 7);
+  SCOPED_TRACE("seed " + std::to_string(kSeed + 7));
+  const std::vector<Vec3> x = perturbed(m, rng, 0.1 * h);
+  ForceEvaluator eval(m);
+  ForceModel model;
+  model.damping = false;
+  model.stiffening = b;
+  std::vector<Vec3> f;
+  eval.evaluate(model, x, {}, f);
+  const double fmax = max_norm(f), delta = 1e-4 * h;
+  EXPECT_LT(max_gradient_mismatch(x, f, delta,
+                                  [&](const std::vector<Vec3>& p) { return spring_energy(m, p, SpringModel::Nonlinear, b); }),
+            1e-6 * fmax);
+
+  const Vec3 a0 = Vec3::Zero(), z = Vec3::Zero();
+  const double l0 = h, k = 100.0;
+  auto force = [&](double stretch, double bb) {
+    return spring_force_nonlinear(Vec3(l0 * (1 + stretch), 0, 0), a0, z, z, l0, k, 0.0, bb)[0];
+  };
+  EXPECT_NEAR(force(1e-6, b) / force(1e-6, 0.0), 1.0, 1e-5);
+  EXPECT_EQ(force(-0.1, b), force(-0.1, 0.0));
+  EXPECT_NEAR(force(0.1, b) / force(0.1, 0.0), std::expm1(1.0), 1e-12);
+
+  const Mat3 rot = Eigen::AngleAxisd(1.0, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  std::vector<Vec3> rotated(m.rest_m.size());
+  for (std::size_t n = 0; n < rotated.size(); ++n) rotated[n] = rot * m.rest_m[n];
+  eval.evaluate(model, rotated, {}, f);
+  double kmax = 0.0;
+  for (double ks : m.spring_k) kmax = std::max(kmax, ks);
+  EXPECT_LT(max_norm(f), 1e-12 * kmax * h);
+}
+
 // ---- determinism ---------------------------------------------------------------------------------------------------
 
 TEST(ForcesDeterminism, BitIdenticalWithOneAndTwoThreads) {

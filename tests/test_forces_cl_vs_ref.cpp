@@ -60,6 +60,7 @@ RandomCase random_case(std::mt19937& rng) {
   c.model.pressure_pa = u(rng) < 0.8 ? 4000.0 * u(rng) : 0.0;
   c.model.volume_stiffness_pa = u(rng) < 0.5 ? 60e3 * u(rng) : 0.0;
   c.model.gravity_m_s2 = u(rng) < 0.3 ? Vec3(0, -9.81, 0) : Vec3::Zero();
+  c.model.stiffening = u(rng) < 0.5 ? 20.0 * u(rng) : 0.0;
   return c;
 }
 
@@ -72,7 +73,9 @@ std::vector<double> force_scales(const RandomCase& c) {
   std::vector<double> s(m.node_count(), 0.0);
   for (std::size_t e = 0; e < m.springs.size(); ++e)
     for (int32_t n : m.springs[e])
-      s[n] += m.spring_k[e] * (m.spring_rest_m[e] + 2 * umax) + (c.model.damping ? m.spring_c[e] * vmax : 0.0);
+      s[n] += m.spring_k[e] * (m.spring_rest_m[e] + 2 * umax +
+                               m.spring_rest_m[e] * stiffened_strain(2 * umax / m.spring_rest_m[e], c.model.stiffening)) +
+              (c.model.damping ? m.spring_c[e] * vmax : 0.0);
   for (std::size_t l = 0; l < m.load_tet.size(); ++l) {
     const auto f = pressure_load_forces(m, int64_t(l), c.x, c.model.pressure_pa);
     for (int i = 0; i < 4; ++i) s[m.tets[m.load_tet[l]][i]] += f[i].norm();

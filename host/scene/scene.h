@@ -127,6 +127,7 @@ struct SceneMaterial {
   double damping_ratio = 0.4;     // ζ, Nimura (§4)
   double spring_scale = 1.0;      // as published; 0.925 matches the lattice to E (§4)
   SpringModel spring_model = SpringModel::Nonlinear;  // rotation-invariant (§5)
+  double stiffening = 0.0;        // b of the exponential spring law (solve/forces.h); 0 = linear
   std::optional<double> volume_stiffness_kpa;          // unset: see effective_volume_stiffness_kpa()
   bool gravity = false;           // the CT already shows the body under gravity (§5)
 };

@@ -164,6 +164,9 @@ const Table<SceneMaterial>& material_table() {
        "Multiplies every spring stiffness; 0.925 makes the lattice's isotropic modulus equal E (§4)."},
       {"spring_model", &SceneMaterial::spring_model, "", any(),
        "\"nonlinear\": rotation-invariant springs (§5); \"linear\": Nimura's Eq. 1 as printed."},
+      {"stiffening", &SceneMaterial::stiffening, "", in(0, 50),
+       "b of the strain-stiffening spring law: tension k·l0·(exp(b·strain) - 1)/b in tension, the small-strain "
+       "stiffness kept; 0 = linear (nonlinear springs only; docs/fidelity.md)."},
       {"volume_stiffness_kpa", &SceneMaterial::volume_stiffness_kpa, "kPa", at_least(0),
        "k_v of Kitasaka's volume-preserving force (§5). Unset: young_kpa for kitasaka2004, 0 (off) for the "
        "other solvers."},

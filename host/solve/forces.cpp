@@ -5,12 +5,14 @@
 namespace pneumo {
 
 Vec3 spring_force_nonlinear(const Vec3& xa, const Vec3& xb, const Vec3& va, const Vec3& vb, double rest, double k,
-                            double c) {
+                            double c, double stiffening) {
   const Vec3 d = xa - xb;
   const double len = d.norm();
   if (!(len > 0.0)) return Vec3::Zero();   // coincident nodes: no direction
   const Vec3 dir = d / len;
-  return -k * (len - rest) * dir - c * (va - vb).dot(dir) * dir;
+  const double stretch = stiffening > 0.0 && rest > 0.0 ? rest * stiffened_strain((len - rest) / rest, stiffening)
+                                                         : len - rest;
+  return -k * stretch * dir - c * (va - vb).dot(dir) * dir;
 }
 
 Vec3 spring_force_linear(const Vec3& xa, const Vec3& xb, const Vec3& xa0, const Vec3& xb0, const Vec3& va,
@@ -54,7 +56,8 @@ void ForceEvaluator::evaluate(const ForceModel& model, const std::vector<Vec3>& 
       const Vec3& va = damp ? v[a] : kZero;
       const Vec3& vb = damp ? v[b] : kZero;
       spring_f_[s] = model.spring_model == SpringModel::Nonlinear
-                         ? spring_force_nonlinear(x[a], x[b], va, vb, m.spring_rest_m[s], m.spring_k[s], c)
+                         ? spring_force_nonlinear(x[a], x[b], va, vb, m.spring_rest_m[s], m.spring_k[s], c,
+                                                  model.stiffening)
                          : spring_force_linear(x[a], x[b], m.rest_m[a], m.rest_m[b], va, vb, m.spring_k[s], c);
     }
     if (!tet_f_.empty()) {
@@ -101,13 +104,14 @@ void ForceEvaluator::evaluate(const ForceModel& model, const std::vector<Vec3>& 
   ++evaluations_;
 }
 
-double spring_energy(const Mesh& m, const std::vector<Vec3>& x, SpringModel model) {
+double spring_energy(const Mesh& m, const std::vector<Vec3>& x, SpringModel model, double stiffening) {
   double e = 0.0;
   for (std::size_t s = 0; s < m.springs.size(); ++s) {
     const int32_t a = m.springs[s][0], b = m.springs[s][1];
     if (model == SpringModel::Nonlinear) {
-      const double stretch = (x[a] - x[b]).norm() - m.spring_rest_m[s];
-      e += 0.5 * m.spring_k[s] * stretch * stretch;
+      const double l0 = m.spring_rest_m[s];
+      const double eps = ((x[a] - x[b]).norm() - l0) / l0;
+      e += m.spring_k[s] * l0 * l0 * stiffened_energy_density(eps, stiffening);
     } else {
       e += 0.5 * m.spring_k[s] * ((x[a] - x[b]) - (m.rest_m[a] - m.rest_m[b])).squaredNorm();
     }

@@ -1,6 +1,7 @@
 #pragma once
 // Forces on the mesh nodes (method.md §5), the plain C++ reference in double precision.
 // Positions in metres, velocities in m/s, forces in newtons, pressure in pascal.
+#include <cmath>
 #include <vector>
 
 #include "mesh/adjacency.h"
@@ -14,7 +15,17 @@ struct ForceModel {
   double pressure_pa = 0.0;            // gas pressure on the cavity faces (mesh.h)
   double volume_stiffness_pa = 0.0;    // Kitasaka's k_v; 0 = off
   Vec3 gravity_m_s2 = Vec3::Zero();    // option (Bano); zero = off
+  double stiffening = 0.0;             // b of the exponential spring law (stiffened_strain); 0 = linear
 };
+
+/// The strain-stiffening spring law (material.stiffening, docs/fidelity.md): a nonlinear spring's
+/// tension is k·l₀·g(ε) with ε = (|d| − l₀)/l₀ and g(ε) = (e^{bε} − 1)/b in tension (Fung's exponential,
+/// the small-strain stiffness k kept: g'(0) = 1), g(ε) = ε in compression and for b = 0. Its energy is
+/// k·l₀²·G(ε), G = (e^{bε} − 1 − bε)/b² in tension, ε²/2 otherwise.
+inline double stiffened_strain(double eps, double b) { return b > 0.0 && eps > 0.0 ? std::expm1(b * eps) / b : eps; }
+inline double stiffened_energy_density(double eps, double b) {
+  return b > 0.0 && eps > 0.0 ? (std::expm1(b * eps) - b * eps) / (b * b) : 0.5 * eps * eps;
+}
 
 /// Evaluates every force term for positions x and velocities v (v may be empty: no damping).
 /// The result has one entry per node; held axes are not zeroed here (the integrators do that).
@@ -35,8 +46,9 @@ class ForceEvaluator {
 };
 
 /// Nonlinear spring and damper force on node a of spring (a,b): f_a = −k(|d|−|d₀|)d̂ − c(v_ab·d̂)d̂ (§5).
+/// With stiffening b > 0 the elastic part is −k·l₀·g(ε)·d̂ (stiffened_strain).
 Vec3 spring_force_nonlinear(const Vec3& xa, const Vec3& xb, const Vec3& va, const Vec3& vb, double rest, double k,
-                            double c);
+                            double c, double stiffening = 0.0);
 /// Nimura's Eq. 1 as printed (option): f_a = −k(d − d₀) − c v_ab. Not rotation-invariant.
 Vec3 spring_force_linear(const Vec3& xa, const Vec3& xb, const Vec3& xa0, const Vec3& xb0, const Vec3& va,
                          const Vec3& vb, double k, double c);
@@ -44,7 +56,7 @@ Vec3 spring_force_linear(const Vec3& xa, const Vec3& xb, const Vec3& xa0, const 
 std::array<Vec3, 4> tet_volume_gradient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 
 /// Potential energies (J), for invariants and tests.
-double spring_energy(const Mesh& m, const std::vector<Vec3>& x, SpringModel model);
+double spring_energy(const Mesh& m, const std::vector<Vec3>& x, SpringModel model, double stiffening = 0.0);
 double volume_energy(const Mesh& m, const std::vector<Vec3>& x, double volume_stiffness_pa);
 double kinetic_energy(const Mesh& m, const std::vector<Vec3>& v);
 /// Tetrahedra whose signed volume is ≤ 0.

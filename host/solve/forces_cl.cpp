@@ -246,7 +246,7 @@ void ClForceEvaluator::evaluate(const ForceModel& model, Nodes which) {
   const int64_t blocks = which == Nodes::All ? blocks_ : free_blocks_;
   ocl::set_args(k_node_, x_, v_, mass_, cl_int(blocks), block_nodes_, spring_begin_, spring_node_, spring_k_,
                 spring_c_, spring_rest_[0], spring_rest_[1], spring_rest_[2], spring_rest_[3],
-                cl_int(model.spring_model == SpringModel::Linear), cl_int(model.damping), load_force_, load_begin_,
+                cl_int(model.spring_model == SpringModel::Linear), cl_int(model.damping), float(model.stiffening), load_force_, load_begin_,
                 node_load_, cl_int(pressure), tet_force_, tet_begin_, node_tet_, cl_int(volume),
                 cl_float4{{float(model.gravity_m_s2[0]), float(model.gravity_m_s2[1]), float(model.gravity_m_s2[2]), 0.0f}},
                 f_);

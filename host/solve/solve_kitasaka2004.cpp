@@ -20,7 +20,7 @@ Vec3 node_force(const Mesh& m, const Adjacency& adj, const ForceModel& model, co
     const int32_t s = adj.springs.item[e] / 8, slot = adj.springs.item[e] % 8;
     const int32_t a = m.springs[s][slot], b = m.springs[s][1 - slot];
     f += model.spring_model == SpringModel::Nonlinear
-             ? spring_force_nonlinear(x[a], x[b], kZero, kZero, m.spring_rest_m[s], m.spring_k[s], 0.0)
+             ? spring_force_nonlinear(x[a], x[b], kZero, kZero, m.spring_rest_m[s], m.spring_k[s], 0.0, model.stiffening)
              : spring_force_linear(x[a], x[b], m.rest_m[a], m.rest_m[b], kZero, kZero, m.spring_k[s], 0.0);
   }
   if (model.volume_stiffness_pa != 0.0)

@@ -40,6 +40,7 @@ SolveOptions solve_options_from_scene(const Scene& s) {
   SolveOptions o;
   o.method = s.solver.method;
   o.forces.spring_model = s.material.spring_model;
+  o.forces.stiffening = s.material.stiffening;
   o.forces.pressure_pa = units::mmhg_to_pa(s.load.pressure_mmhg);
   o.forces.volume_stiffness_pa = units::kpa_to_pa(s.effective_volume_stiffness_kpa());
   if (s.material.gravity) o.forces.gravity_m_s2 = Vec3(0, -9.81, 0);   // supine: down is posterior (−y in RAS)
