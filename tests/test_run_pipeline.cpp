@@ -175,7 +175,8 @@ TEST(RunPipeline, ResumeFromACheckpointReachesTheSameShape) {
 TEST(RunPipeline, RealCtEndToEnd) {
   // Compared: the real CT's case (scenes/totalseg_example.json, automatic wall roles, reduced: 4 mmHg
   // steps of the static solver as the scene has them, views at 128×96) against the same plausibility as
-  // the phantom: outputs on the input's grid, the wall rises (> 5 mm), a cavity opens (> 20 ml of warped
+  // the phantom: outputs on the working grid (the input's spacing and direction, grown by the scene's
+  // padding, holding the input's grid), the wall rises (> 5 mm), a cavity opens (> 20 ml of warped
   // gas; the CT's field of view is tight), nothing inverts, the exterior views are not blank.
   PNEUMO_REQUIRE_SHARED_DATA();
   Progress::set_enabled(false);
@@ -189,7 +190,18 @@ TEST(RunPipeline, RealCtEndToEnd) {
   EXPECT_TRUE(s.converged);
   const fs::path out(o.out_dir);
   const Volume ct = read_volume(scene.require_ct());
-  EXPECT_TRUE(read_volume((out / "deformed_ct.nii.gz").string()).geometry().same_grid(ct.geometry()));
+  const Geometry out_grid = read_volume((out / "deformed_ct.nii.gz").string()).geometry();
+  EXPECT_TRUE(out_grid.spacing_mm.isApprox(ct.geometry().spacing_mm, 1e-9));
+  EXPECT_TRUE(out_grid.direction.isApprox(ct.geometry().direction, 1e-9));
+  for (int a = 0; a < 3; ++a) EXPECT_GE(out_grid.dims[a], ct.geometry().dims[a]);
+  for (const Vec3& corner : {Vec3(0, 0, 0), Vec3(double(ct.geometry().dims[0] - 1), double(ct.geometry().dims[1] - 1),
+                                               double(ct.geometry().dims[2] - 1))}) {
+    const Vec3 idx = out_grid.to_index(ct.geometry().to_world(corner));
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_GE(idx[a], -1e-6);
+      EXPECT_LE(idx[a], double(out_grid.dims[a] - 1) + 1e-6);
+    }
+  }
   const nlohmann::json& m = s.metrics;
   EXPECT_GT(m.at("anterior_rise_mm").get<double>(), 5.0);
   EXPECT_GT(m.at("cavity_volume_ml").get<double>(), 20.0);

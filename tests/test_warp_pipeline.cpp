@@ -254,12 +254,15 @@ TEST_F(WarpPipeline, DeformationFileRoundTripsAndFingerprintsTheMesh) {
   EXPECT_THROW(read_deformation(dir.file("d.bin"), moved), InputError);
 }
 
-// Identity through the whole chain, on a scene that pads the CT (the output box is then inside the
-// working grid): a zero deformation writes the input CT and labels back bit for bit, same types.
+// Identity through the whole chain, on a scene that pads the CT: with output.grid "input" (the output
+// box inside the working grid) a zero deformation writes the input CT and labels back bit for bit, same
+// types; with "working" (the default) it writes the padded CT: the input's voxels at the padding's offset,
+// air (−1000 HU) and label 0 around them, on the input's spacing and direction.
 TEST_F(WarpPipeline, ZeroDeformationWritesTheInputBackBitForBit) {
   Scene scene = load_scene(path("case/scene.json"));
   scene.roles.pad_anterior_mm = 20.0;
   scene.roles.pad_superior_mm = 8.0;
+  scene.output.grid = OutputGrid::Input;
   const RoleVolume roles = load_roles(scene);
   ASSERT_FALSE(roles.pad.empty());
   const Mesh mesh = build_scene_mesh(VoxelRoles{roles.geometry, roles.role.data(), roles.label.data()}, scene);
@@ -273,4 +276,30 @@ TEST_F(WarpPipeline, ZeroDeformationWritesTheInputBackBitForBit) {
   EXPECT_EQ(w.cavity_voxels(), 0);
   EXPECT_TRUE(read_volume(dir.file("deformed_ct.nii.gz")).same_voxels(read_volume(path("case/ct.nii.gz"))));
   EXPECT_TRUE(read_volume(dir.file("deformed_labels.nii.gz")).same_voxels(read_volume(path("case/labels.nii.gz"))));
+
+  scene.output.grid = OutputGrid::Working;
+  ScratchDir grown;
+  write_deformation(grown.file("deformation.bin"), mesh, zero);
+  std::ofstream(grown.file("metrics.json")) << "{}";
+  const WarpedCase g = warp_scene(scene, grown.path().string());
+  write_warp(scene, g, grown.path().string());
+  const Volume ct_in = read_volume(path("case/ct.nii.gz")), labels_in = read_volume(path("case/labels.nii.gz"));
+  const Volume ct_out = read_volume(grown.file("deformed_ct.nii.gz")), labels_out = read_volume(grown.file("deformed_labels.nii.gz"));
+  ASSERT_TRUE(ct_out.geometry().same_grid(roles.geometry));
+  EXPECT_EQ(ct_out.type(), ct_in.type());
+  const Index3& d = roles.geometry.dims;
+  const Index3& lo = roles.pad.lo;
+  const Index3& din = ct_in.geometry().dims;
+  int64_t wrong = 0;
+  for (int64_t k = 0; k < d[2]; ++k)
+    for (int64_t j = 0; j < d[1]; ++j)
+      for (int64_t i = 0; i < d[0]; ++i) {
+        const int64_t v = roles.geometry.linear_index(i, j, k);
+        const int64_t a = i - lo[0], b = j - lo[1], c = k - lo[2];
+        const bool inside = a >= 0 && b >= 0 && c >= 0 && a < din[0] && b < din[1] && c < din[2];
+        const int64_t src = inside ? ct_in.geometry().linear_index(a, b, c) : -1;
+        wrong += ct_out.value(v) != (inside ? ct_in.value(src) : -1000.0);
+        wrong += labels_out.value(v) != (inside ? labels_in.value(src) : 0.0);
+      }
+  EXPECT_EQ(wrong, 0);
 }

@@ -117,19 +117,22 @@ WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labe
   src.ct_hu = w.roles.ct.data<float>();
   src.labels = w.labels ? w.roles.label.data() : nullptr;
   src.roles = w.roles.role.data();
+  // The working grid holds the mesh, so the deformed body too unless it rises beyond the padding.
+  const bool working = scene.output.grid == OutputGrid::Working;
+  w.output_grid = working ? w.roles.geometry : w.ct.geometry();
   WarpBox box;
-  box.lo = w.roles.pad.lo;
-  box.dims = w.ct.geometry().dims;
+  box.lo = working ? Index3{0, 0, 0} : w.roles.pad.lo;
+  box.dims = w.output_grid.dims;
   WarpOptions opt;
   opt.cavity_label = cavity;
   const auto t0 = std::chrono::steady_clock::now();
   w.result = warp_on_device(scene.device, w.warp_mesh, src, box, opt);
-  const Vec3& s = w.ct.geometry().spacing_mm;
+  const Vec3& s = w.output_grid.spacing_mm;
   w.voxel_volume_ml = s[0] * s[1] * s[2] / 1000.0;
   const int64_t min_voxels = int64_t(std::ceil(scene.output.min_cavity_piece_ml / w.voxel_volume_ml));
   w.specks = fill_cavity_specks(w.result, box.dims, min_voxels);
   w.seconds_warp = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  w.cavity_centroid_mm = cavity_centroid(w.result, w.ct.geometry());
+  w.cavity_centroid_mm = cavity_centroid(w.result, w.output_grid);
   return w;
 }
 
@@ -137,7 +140,7 @@ Volume deformed_ct_volume(const WarpedCase& w) {
   VoxelType t = w.ct.type();
   if (t != VoxelType::Int16 && t != VoxelType::Int32 && t != VoxelType::Float32 && t != VoxelType::Float64)
     t = VoxelType::Float32;
-  Volume v(w.ct.geometry(), t);
+  Volume v(w.output_grid, t);
   dispatch_voxel_type(t, v.raw(), [&](auto* p) {
     using T = std::remove_pointer_t<decltype(p)>;
     fill_rounded<T>(v, w.result.ct_hu);
@@ -154,7 +157,7 @@ Volume deformed_label_volume(const WarpedCase& w, int cavity_label) {
     fits = std::is_integral_v<T> && double(cavity_label) <= double(std::numeric_limits<T>::max());
   });
   if (!fits) t = VoxelType::UInt16;
-  Volume v(w.ct.geometry(), t);
+  Volume v(w.output_grid, t);
   dispatch_voxel_type(t, v.raw(), [&](auto* p) {
     for (std::size_t n = 0; n < w.result.labels.size(); ++n) p[n] = static_cast<std::remove_pointer_t<decltype(p)>>(w.result.labels[n]);
   });
@@ -171,7 +174,7 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
   if (!w.result.labels.empty()) {
     std::vector<uint8_t> gas(w.result.labels.size());
     for (std::size_t n = 0; n < gas.size(); ++n) gas[n] = w.result.labels[n] == uint16_t(scene.output.cavity_label);
-    const int64_t largest = keep_largest_component(gas, w.ct.geometry().dims);
+    const int64_t largest = keep_largest_component(gas, w.output_grid.dims);
     j["cavity_largest_piece_ml"] = double(largest) * w.voxel_volume_ml;
     j["cavity_specks_filled"] = {{"pieces", w.specks.pieces}, {"voxels", w.specks.voxels},
                                  {"below_ml", scene.output.min_cavity_piece_ml}};
@@ -203,7 +206,7 @@ void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir)
     std::vector<uint8_t> gas(w.result.outcome.size());
     for (std::size_t n = 0; n < gas.size(); ++n) gas[n] = w.result.outcome[n] == WarpOutcome::Gas;
     SliceOverlay overlay;
-    overlay.geometry = w.ct.geometry();
+    overlay.geometry = w.output_grid;
     overlay.classes = gas.data();
     char name[96];
     std::snprintf(name, sizeof name, "CO2 cavity %.0f ml", w.cavity_volume_ml());
@@ -211,7 +214,8 @@ void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir)
     SliceView view;
     view.point_mm = w.cavity_centroid_mm;
     view.title = "before";
-    const RgbImage before = render_slice_row(w.ct, nullptr, view);
+    // Before on the same grid as after (the padded CT on the working grid), so both rows frame alike.
+    const RgbImage before = render_slice_row(w.output_grid.same_grid(w.ct.geometry()) ? w.ct : w.roles.ct, nullptr, view);
     char title[160];
     std::snprintf(title, sizeof title, "after, %.1f mmHg (cavity in blue)",
                   w.deformation.pressure_pa / units::kPaPerMmHg);

@@ -26,7 +26,8 @@ struct WarpedCase {
   Mesh mesh;
   Deformation deformation;
   WarpMesh warp_mesh;
-  WarpResult result;              // on the CT's grid
+  WarpResult result;              // on output_grid
+  Geometry output_grid;           // output.grid: the working grid or the CT's
   double voxel_volume_ml = 0.0;
   std::optional<Vec3> cavity_centroid_mm;   // none when no voxel became gas
   double seconds_warp = 0.0;

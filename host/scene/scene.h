@@ -33,6 +33,9 @@ enum class Lens : uint8_t { Pinhole, Fisheye };
 enum class RenderPreset : uint8_t { Laparoscopic, CtSoftTissue, CtMuscle, CtAaa, CtAir, Custom };
 /// Speed against accuracy (scene_presets.h): what `pneumo bench` measured each to buy.
 enum class ScenePreset : uint8_t { None, Preview, Balanced, Accurate };
+/// The grid of the deformed CT and labels: the working grid (the CT with the roles' padding, which
+/// holds the mesh and so the risen dome) or the input CT's own.
+enum class OutputGrid : uint8_t { Working, Input };
 
 /// How each enum's values are written in scene files, indexed by the value: the one place these
 /// names are spelled (the parser, the reference and enum_name() all read them from here).
@@ -66,6 +69,9 @@ template <> struct EnumNames<RenderPreset> {
                                                     "ct-aaa", "ct-air", "custom"};
 };
 
+template <> struct EnumNames<OutputGrid> {
+  static constexpr std::array<const char*, 2> names{"working", "input"};
+};
 template <> struct EnumNames<ScenePreset> {
   static constexpr std::array<const char*, 4> names{"none", "preview", "balanced", "accurate"};
 };
@@ -223,6 +229,7 @@ struct SceneOutput {
   bool write_meshes = false;
   bool write_deformed_ct = true;
   bool write_deformed_labels = true;
+  OutputGrid grid = OutputGrid::Working;
   // Label id of the CO2 cavity in the warped label map (§7). TotalSegmentator's ids end at 117 and
   // the phantom's own at 207; 250 is free in both. A label map that already uses it is refused.
   int cavity_label = 250;

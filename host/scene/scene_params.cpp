@@ -333,6 +333,9 @@ const Table<SceneOutput>& output_table() {
       {"write_deformed_ct", &SceneOutput::write_deformed_ct, "", any(), "Write the warped CT (§7)."},
       {"write_deformed_labels", &SceneOutput::write_deformed_labels, "", any(),
        "Write the warped label map (with the cavity label) when a label map is given (§7)."},
+      {"grid", &SceneOutput::grid, "", any(),
+       "Grid of deformed_ct and deformed_labels: \"working\" = the CT grown by roles.pad_* (same spacing and "
+       "direction; it holds the mesh, so a dome that rises out of the CT is not clipped), \"input\" = the CT's own."},
       {"cavity_label", &SceneOutput::cavity_label, "", in(1, 65535),
        "Label id of the CO2 cavity in the warped label map (§7); must not be an id the label map uses."},
       {"min_cavity_piece_ml", &SceneOutput::min_cavity_piece_ml, "ml", in(0, 1e6),
