@@ -274,6 +274,7 @@ TEST_F(WarpPipeline, ZeroDeformationWritesTheInputBackBitForBit) {
   const WarpedCase w = warp_scene(scene, dir.path().string());
   write_warp(scene, w, dir.path().string());
   EXPECT_EQ(w.cavity_voxels(), 0);
+  EXPECT_EQ(w.outside_grid_mm, 0.0);   // the rest mesh lies on the grid
   EXPECT_TRUE(read_volume(dir.file("deformed_ct.nii.gz")).same_voxels(read_volume(path("case/ct.nii.gz"))));
   EXPECT_TRUE(read_volume(dir.file("deformed_labels.nii.gz")).same_voxels(read_volume(path("case/labels.nii.gz"))));
 
@@ -302,4 +303,13 @@ TEST_F(WarpPipeline, ZeroDeformationWritesTheInputBackBitForBit) {
         wrong += labels_out.value(v) != (inside ? labels_in.value(src) : 0.0);
       }
   EXPECT_EQ(wrong, 0);
+
+  // Moved 1 m to the right, the body leaves any grid: reported by at least the grid's own width.
+  Deformation away = zero;
+  for (Vec3& u : away.displacement_m) u = Vec3(1.0, 0.0, 0.0);
+  ScratchDir moved;
+  write_deformation(moved.file("deformation.bin"), mesh, away);
+  std::ofstream(moved.file("metrics.json")) << "{}";
+  const WarpedCase m = warp_scene(scene, moved.path().string());
+  EXPECT_GT(m.outside_grid_mm, 1000.0 - double(roles.geometry.dims[0]) * roles.geometry.spacing_mm[0]);
 }

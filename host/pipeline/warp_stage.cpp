@@ -20,6 +20,17 @@
 namespace pneumo {
 
 namespace {
+char opposite_orientation_letter(char c) {
+  switch (c) {
+    case 'R': return 'L';
+    case 'L': return 'R';
+    case 'A': return 'P';
+    case 'P': return 'A';
+    case 'S': return 'I';
+    case 'I': return 'S';
+    default: return '?';
+  }
+}
 
 namespace fs = std::filesystem;
 
@@ -133,6 +144,34 @@ WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labe
   w.specks = fill_cavity_specks(w.result, box.dims, min_voxels);
   w.seconds_warp = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   w.cavity_centroid_mm = cavity_centroid(w.result, w.output_grid);
+  // A dome that rises beyond the output grid is clipped there: say by how much, where, and what to
+  // change. Nodes on a face of the grid (where the CT ends) sit on it at rest, so a millimetre or two
+  // there is the CT's own cut; a voxel or more is reported.
+  const std::string code = w.output_grid.orientation_code();
+  double worst = 0.0;
+  char side = '?';
+  for (int64_t n = 0; n < w.mesh.node_count(); ++n) {
+    const Vec3 x_mm = units::m_to_mm(1.0) * (w.mesh.rest_m[n] + w.deformation.displacement_m[n]);
+    const Vec3 idx = w.output_grid.to_index(x_mm);
+    for (int a = 0; a < 3; ++a) {
+      const double h = w.output_grid.spacing_mm[a];
+      const double low = (-0.5 - idx[a]) * h, high = (idx[a] - (double(w.output_grid.dims[a]) - 0.5)) * h;
+      if (high > worst) { worst = high; side = code[a]; }
+      if (low > worst) { worst = low; side = opposite_orientation_letter(code[a]); }
+    }
+  }
+  w.outside_grid_mm = worst;
+  if (worst >= w.output_grid.spacing_mm.maxCoeff()) {
+    const char* key = side == 'A' ? "roles.pad_anterior_mm" : side == 'S' ? "roles.pad_superior_mm"
+                    : side == 'I' ? "roles.pad_inferior_mm" : (side == 'R' || side == 'L') ? "roles.pad_lateral_mm"
+                                                                                              : "the field of view";
+    char msg[320];
+    std::snprintf(msg, sizeof msg,
+                  "warp: the deformed body reaches %.1f mm beyond the output grid (side %c) and is clipped there; "
+                  "raise %s%s",
+                  worst, side, key, working ? "" : " and set output.grid to \"working\"");
+    log::warn(msg);
+  }
   return w;
 }
 
@@ -167,6 +206,7 @@ Volume deformed_label_volume(const WarpedCase& w, int cavity_label) {
 nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
   const double mvox_s = w.seconds_warp > 0 ? double(w.result.ct_hu.size()) / w.seconds_warp / 1e6 : 0.0;
   nlohmann::json j;
+  j["deformed_body_outside_grid_mm"] = w.outside_grid_mm;
   j["cavity_voxels"] = w.cavity_voxels();
   j["cavity_volume_ml"] = w.cavity_volume_ml();
   // The gas should be one connected cavity (issue "A human answer"): the share of it outside its

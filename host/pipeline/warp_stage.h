@@ -28,6 +28,7 @@ struct WarpedCase {
   WarpMesh warp_mesh;
   WarpResult result;              // on output_grid
   Geometry output_grid;           // output.grid: the working grid or the CT's
+  double outside_grid_mm = 0.0;   // how far the deformed mesh reaches beyond output_grid (0: inside)
   double voxel_volume_ml = 0.0;
   std::optional<Vec3> cavity_centroid_mm;   // none when no voxel became gas
   double seconds_warp = 0.0;
