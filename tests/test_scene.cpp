@@ -187,6 +187,10 @@ TEST(SceneRoundTrip, EveryKeyChangesItsOwnValueOnly) {
     json changed = base;
     changed[ptr] = value;
     std::vector<json::json_pointer> companions;  // keys that must change with this one
+    if (path == "material.model") {   // the finite elements need the Newton solver (scene_validate.cpp)
+      companions.push_back(json::json_pointer("/solver/method"));
+      changed[companions.back()] = "newton";
+    }
     if (path == "render.ports[0].target_label") {
       companions.push_back(ptr.parent_pointer() / "target_mm");
       changed[companions.back()] = nullptr;
@@ -542,7 +546,7 @@ TEST(SceneReference, ListsEveryKey) {
                               "## `render.paths[].keyframes[]` (each item)", "## `material.label_young_kpa[]` (each item)"})
     EXPECT_CONTAINS(md, heading);
   for (const char* row : {"| `pressure_mmhg` | number | `12.0` | 0 to 100 | mmHg |", "| `fov_deg` | number | `70.0` |",
-                          "| `method` | enum | `\"static\"` | \"static\", \"explicit\", \"newmark\", \"kitasaka2004\" |"})
+                          "| `method` | enum | `\"static\"` | \"static\", \"explicit\", \"newmark\", \"kitasaka2004\", \"newton\" |"})
     EXPECT_CONTAINS(md, row);
 }
 

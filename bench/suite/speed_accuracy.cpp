@@ -32,7 +32,8 @@ struct Config {
 
 const char* setting_name(SolverMethod m) {
   switch (m) {
-    case SolverMethod::Static: return "residual_tolerance";
+    case SolverMethod::Static:
+    case SolverMethod::Newton: return "residual_tolerance";
     case SolverMethod::Explicit:
     case SolverMethod::Newmark: return "dt_safety";
     case SolverMethod::Kitasaka2004: return "kitasaka_tolerance_mm_per_node";

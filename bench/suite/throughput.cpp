@@ -19,6 +19,7 @@
 #include "render/transfer_function.h"
 #include "solve/forces_cl.h"
 #include "solve/solver.h"
+#include "solve/solve_on_device.h"
 #include "solve/solver_cl.h"
 #include "warp/warp.h"
 #include "warp/warp_mesh.h"
@@ -226,8 +227,8 @@ json measure_case_throughput(BenchContext& ctx, const BenchCase& c, int pipeline
         SolveResult r;
         WarpResult w;
         auto t0 = Clock::now();
-        if (d.opencl()) r = solve_opencl(ctx.cl(d), c.mesh, base);
-        else with_threads(d.threads, [&] { r = solve(c.mesh, base); });
+        if (d.opencl()) r = solve_on_device(&ctx.cl(d), c.mesh, base);
+        else with_threads(d.threads, [&] { r = solve_on_device(nullptr, c.mesh, base); });
         solve_s.push_back(seconds_since(t0));
         std::vector<Vec3> u(r.x.size());
         for (std::size_t n = 0; n < u.size(); ++n) u[n] = r.x[n] - c.mesh.rest_m[n];

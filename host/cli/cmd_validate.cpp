@@ -15,6 +15,8 @@ Run add_validate(CLI::App& app) {
     bool json = false;
     int across = 6;
     LameOptions lame;
+    std::string lame_model = "msd";
+    bool per_tetrahedron = false;
     std::string scene;
     std::vector<int> cube_voxels{4, 3, 2, 1};
     std::vector<double> pressures = default_pressure_volume_pressures();
@@ -27,6 +29,17 @@ Run add_validate(CLI::App& app) {
   lame->add_option("--cube-mm", o->lame.cube_mm, "Cube size in mm")->capture_default_str()->check(CLI::Range(1.0, 50.0));
   lame->add_option("--placements", o->lame.placements, "Positions of the sphere's centre relative to the lattice, averaged")
       ->capture_default_str()->check(CLI::Range(1, 64));
+  lame->add_option("--model", o->lame_model, "Material model: msd, fem-corotational or fem-neohookean")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"msd", "fem-corotational", "fem-neohookean"}));
+  lame->add_option("--poisson", o->lame.poisson, "Poisson's ratio of the finite elements (the springs' is 1/4)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.49));
+  lame->add_option("--voxel-mm", o->lame.voxel_mm, "Voxel size of the sphere's image (0: one voxel per cube)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 50.0));
+  lame->add_flag("--per-tetrahedron", o->per_tetrahedron,
+                 "FEM: the dilatation per tetrahedron instead of averaged per cube (shows volumetric locking)");
   lame->add_flag("--json", o->json, "Print JSON (u_inner_mm, u_inner_analytic_mm, rel_error_inner, ...)");
   auto* conv = cmd->add_subcommand(
       "convergence", "One scene solved with several cube sizes: rise, cavity and wall displacement, with the observed order");
@@ -92,18 +105,24 @@ Run add_validate(CLI::App& app) {
                     r.young_ratio_axis, 100.0 * (r.young_ratio_axis / r.expected_axis - 1.0), r.cubes_across);
       return 0;
     }
+    for (std::size_t i = 0; i < EnumNames<MaterialModel>::names.size(); ++i)
+      if (o->lame_model == EnumNames<MaterialModel>::names[i]) o->lame.model = MaterialModel(i);
+    o->lame.mean_dilatation = !o->per_tetrahedron;
+    if (o->lame.model == MaterialModel::Msd && o->lame.poisson != 0.25)
+      throw InputError("validate lame-sphere: --poisson applies to the FEM models; the springs' ν is 1/4");
     const LameResult r = validate_lame_sphere(o->lame);
     if (o->json) std::cout << to_json(r).dump(2) << "\n";
     else {
-      std::printf("Lamé sphere a = %g mm, b = %g mm, E = %g kPa, %g mmHg, cubes %g mm, %d placements "
+      std::printf("Lamé sphere a = %g mm, b = %g mm, E = %g kPa, nu = %g, %s, %g mmHg, cubes %g mm, %d placements "
                   "(%lld nodes each, %.1f s)\n",
-                  o->lame.inner_mm, o->lame.outer_mm, o->lame.young_kpa, o->lame.pressure_mmhg, o->lame.cube_mm,
-                  o->lame.placements, (long long)r.nodes, r.wall_time_s);
-      std::printf("  inner: %.4f mm, nominal %.4f (%+.1f %%), lattice moduli %.4f (%+.1f %%)\n", r.u_inner_mm,
+                  o->lame.inner_mm, o->lame.outer_mm, o->lame.young_kpa,
+                  o->lame.model == MaterialModel::Msd ? 0.25 : o->lame.poisson, o->lame_model.c_str(),
+                  o->lame.pressure_mmhg, o->lame.cube_mm, o->lame.placements, (long long)r.nodes, r.wall_time_s);
+      std::printf("  inner: %.4f mm, nominal %.4f (%+.1f %%), model's moduli %.4f (%+.1f %%)\n", r.u_inner_mm,
                   r.u_inner_analytic_mm, 100 * r.rel_error_inner, r.u_inner_lattice_mm, 100 * r.rel_error_inner_lattice);
       std::printf("         placements %.4f … %.4f mm; plain node mean %.4f mm\n", r.u_inner_min_mm, r.u_inner_max_mm,
                   r.u_inner_node_mean_mm);
-      std::printf("  outer: %.4f mm, nominal %.4f (%+.1f %%), lattice moduli %.4f (%+.1f %%)\n", r.u_outer_mm,
+      std::printf("  outer: %.4f mm, nominal %.4f (%+.1f %%), model's moduli %.4f (%+.1f %%)\n", r.u_outer_mm,
                   r.u_outer_analytic_mm, 100 * r.rel_error_outer, r.u_outer_lattice_mm, 100 * r.rel_error_outer_lattice);
       std::printf("         placements %.4f … %.4f mm; plain node mean %.4f mm\n", r.u_outer_min_mm, r.u_outer_max_mm,
                   r.u_outer_node_mean_mm);

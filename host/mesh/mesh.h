@@ -81,6 +81,7 @@ struct Mesh {
   std::vector<int64_t> tet_cube;            // linear cube index
   std::vector<double> tet_rest_volume_m3;
   std::vector<double> tet_young_pa;         // the volume average over its tissue (0 outside it), floored
+  std::vector<double> tet_poisson;          // ν of the finite elements (empty: 1/4, the springs' own)
   std::vector<std::array<int32_t, 6>> tet_springs;   // spring of each local edge (kTetEdges order)
 
   // Springs (one per unique tetrahedron edge, per part).

@@ -16,7 +16,7 @@
 #include "mesh/vtu_writer.h"
 #include "report/plot_svg.h"
 #include "solve/solvable.h"
-#include "solve/solver_cl.h"
+#include "solve/solve_on_device.h"
 
 namespace pneumo {
 
@@ -78,7 +78,7 @@ void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hoo
     sim.device = "cpu";
   }
   auto run = [&](const SolveOptions& opt, const std::vector<Vec3>& x_start) {
-    return ctx ? solve_opencl(*ctx, sim.mesh, opt, x_start) : solve(sim.mesh, opt, x_start);
+    return solve_on_device(ctx.get(), sim.mesh, opt, x_start);
   };
   SolveOptions base = solve_options_from_scene(scene);
   base.snapshot_every_steps = hooks.snapshot_every_steps;

@@ -26,8 +26,10 @@ enum class Role : uint8_t { Other = 0, Wall = 1, Viscera = 2, Fixed = 3 };
 enum class RoleSource : uint8_t { Labels, Auto };
 enum class MeshModel : uint8_t { WallViscera, Wall };
 enum class SpringModel : uint8_t { Nonlinear, Linear };
+/// The material model on the tetrahedra: the springs of §4–5 or finite elements (solve/fem_element.h).
+enum class MaterialModel : uint8_t { Msd, FemCorotational, FemNeoHookean };
 enum class RampShape : uint8_t { Smooth, Linear };
-enum class SolverMethod : uint8_t { Static, Explicit, Newmark, Kitasaka2004 };
+enum class SolverMethod : uint8_t { Static, Explicit, Newmark, Kitasaka2004, Newton };
 enum class OnInverted : uint8_t { Continue, Stop };
 enum class Lens : uint8_t { Pinhole, Fisheye };
 enum class RenderPreset : uint8_t { Laparoscopic, CtSoftTissue, CtMuscle, CtAaa, CtAir, Custom };
@@ -52,11 +54,14 @@ template <> struct EnumNames<MeshModel> {
 template <> struct EnumNames<SpringModel> {
   static constexpr std::array<const char*, 2> names{"nonlinear", "linear"};
 };
+template <> struct EnumNames<MaterialModel> {
+  static constexpr std::array<const char*, 3> names{"msd", "fem-corotational", "fem-neohookean"};
+};
 template <> struct EnumNames<RampShape> {
   static constexpr std::array<const char*, 2> names{"smooth", "linear"};
 };
 template <> struct EnumNames<SolverMethod> {
-  static constexpr std::array<const char*, 4> names{"static", "explicit", "newmark", "kitasaka2004"};
+  static constexpr std::array<const char*, 5> names{"static", "explicit", "newmark", "kitasaka2004", "newton"};
 };
 template <> struct EnumNames<OnInverted> {
   static constexpr std::array<const char*, 2> names{"continue", "stop"};
@@ -119,6 +124,7 @@ struct SceneMesh {
 struct LabelYoung {
   int label = 0;
   double young_kpa = 0.0;
+  std::optional<double> poisson_ratio;   // the finite elements only; unset = the role's
 };
 
 struct SceneMaterial {
@@ -133,6 +139,11 @@ struct SceneMaterial {
   double damping_ratio = 0.4;     // ζ, Nimura (§4)
   double spring_scale = 1.0;      // as published; 0.925 matches the lattice to E (§4)
   SpringModel spring_model = SpringModel::Nonlinear;  // rotation-invariant (§5)
+  MaterialModel model = MaterialModel::Msd;           // springs, or finite elements (docs/fem.md)
+  // ν of the finite elements (the springs' is fixed at 1/4): Bano 2012 used 0.49 for the wall.
+  double poisson_ratio = 0.45;
+  std::optional<double> wall_poisson_ratio, viscera_poisson_ratio;
+  bool mean_dilatation = true;    // FEM: volumetric strain averaged per cube, against locking
   double stiffening = 0.0;        // b of the exponential spring law (solve/forces.h); 0 = linear
   std::optional<double> volume_stiffness_kpa;          // unset: see effective_volume_stiffness_kpa()
   bool gravity = false;           // the CT already shows the body under gravity (§5)
@@ -164,6 +175,7 @@ struct SceneSolver {
   double kitasaka_tolerance_mm = 1.0;    // β of Kitasaka's Eq. 3: Σ|ΔR| over all nodes
   OnInverted on_inverted = OnInverted::Continue;
   int64_t checkpoint_every_steps = 0;    // 0 = off
+  int newton_max_cg_iterations = 500;    // conjugate-gradient iterations per Newton step
 };
 
 /// Optics shared by cameras, ports and paths (§8).
@@ -284,6 +296,8 @@ struct Scene {
   double young_kpa_for(Role role, int label) const;
   /// The same for one voxel of HU `hu`: fat_young_kpa inside the fat window (docs/fidelity.md).
   double young_kpa_for(Role role, int label, float hu) const;
+  /// ν of the finite elements for a role and label.
+  double poisson_for(Role role, int label) const;
 
   /// Kitasaka's k_v (kPa): volume_stiffness_kpa when set; unset: young_kpa for kitasaka2004
   /// (the 2004 scheme needs it: its springs alone let tetrahedra collapse), 0 for the others.

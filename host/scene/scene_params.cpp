@@ -137,6 +137,8 @@ const Table<LabelYoung>& label_young_table() {
   static const Table<LabelYoung> t{
       {"label", &LabelYoung::label, "", in(0, kMaxLabel).req(), "Label id."},
       {"young_kpa", &LabelYoung::young_kpa, "kPa", above(0, kMaxKPa).req(), "Young's modulus of tetrahedra of this label."},
+      {"poisson_ratio", &LabelYoung::poisson_ratio, "", in(0, 0.49),
+       "ν of this label's finite elements; unset = its role's (the springs ignore it)."},
   };
   return t;
 }
@@ -164,9 +166,23 @@ const Table<SceneMaterial>& material_table() {
        "Multiplies every spring stiffness; 0.925 makes the lattice's isotropic modulus equal E (§4)."},
       {"spring_model", &SceneMaterial::spring_model, "", any(),
        "\"nonlinear\": rotation-invariant springs (§5); \"linear\": Nimura's Eq. 1 as printed."},
+      {"model", &SceneMaterial::model, "", any(),
+       "\"msd\": the mass-spring lattice (§4-5); \"fem-corotational\": co-rotational linear tetrahedra (as SOFA, "
+       "Bano 2012); \"fem-neohookean\": neo-Hookean tetrahedra, with Demiray's stiffening when stiffening > 0. The "
+       "FEM models need solver.method \"newton\" (docs/fem.md)."},
+      {"poisson_ratio", &SceneMaterial::poisson_ratio, "", in(0, 0.49),
+       "ν of the finite elements unless overridden (Bano 2012: 0.49 for the wall); the springs' ν is 1/4."},
+      {"wall_poisson_ratio", &SceneMaterial::wall_poisson_ratio, "", in(0, 0.49),
+       "ν of wall finite elements; unset = poisson_ratio."},
+      {"viscera_poisson_ratio", &SceneMaterial::viscera_poisson_ratio, "", in(0, 0.49),
+       "ν of viscera finite elements; unset = poisson_ratio."},
+      {"mean_dilatation", &SceneMaterial::mean_dilatation, "", any(),
+       "FEM: average the volumetric strain over each cube's tetrahedra (B-bar), so nearly incompressible tissue does "
+       "not lock; false = per tetrahedron (docs/fem.md)."},
       {"stiffening", &SceneMaterial::stiffening, "", in(0, 50),
        "b of the strain-stiffening spring law: tension k·l0·(exp(b·strain) - 1)/b in tension, the small-strain "
-       "stiffness kept; 0 = linear (nonlinear springs only; docs/fidelity.md)."},
+       "stiffness kept; 0 = linear (nonlinear springs only; docs/fidelity.md). With fem-neohookean: b of Demiray's "
+       "law, shear energy μ/(2b)(exp(b(I1 - 3)) - 1)."},
       {"volume_stiffness_kpa", &SceneMaterial::volume_stiffness_kpa, "kPa", at_least(0),
        "k_v of Kitasaka's volume-preserving force (§5). Unset: young_kpa for kitasaka2004, 0 (off) for the "
        "other solvers."},
@@ -197,7 +213,8 @@ const Table<SceneSolver>& solver_table() {
   static const Table<SceneSolver> t{
       {"method", &SceneSolver::method, "", any(),
        "\"static\": fast equilibrium; \"explicit\": symplectic Euler; \"newmark\": Nimura's Newmark-β; "
-       "\"kitasaka2004\": Kitasaka's quasi-static scheme (§6)."},
+       "\"kitasaka2004\": Kitasaka's quasi-static scheme (§6); \"newton\": Newton with preconditioned conjugate "
+       "gradients (static; CPU; every material model)."},
       {"dt_ms", &SceneSolver::dt_ms, "ms", in(0, 1000),
        "Time step of explicit and newmark; 0 = dt_safety × the stability bound (§6)."},
       {"dt_safety", &SceneSolver::dt_safety, "", above(0, 1), "Fraction of the stability bound used when dt_ms = 0."},
@@ -222,6 +239,8 @@ const Table<SceneSolver>& solver_table() {
        "When a tetrahedron turns inside out: \"continue\" (counted and reported) or \"stop\"."},
       {"checkpoint_every_steps", &SceneSolver::checkpoint_every_steps, "", in(0, 1e9),
        "Save the node state every this many steps, to resume a long run; 0 = never."},
+      {"newton_max_cg_iterations", &SceneSolver::newton_max_cg_iterations, "", in(1, 100000),
+       "newton: conjugate-gradient iterations allowed per Newton step (the step keeps what it reached)."},
   };
   return t;
 }

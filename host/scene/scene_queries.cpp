@@ -37,6 +37,14 @@ double Scene::young_kpa_for(Role role, int label, float hu) const {
   return young_kpa_for(role, label);
 }
 
+double Scene::poisson_for(Role role, int label) const {
+  for (const LabelYoung& l : material.label_young_kpa)
+    if (l.label == label && l.poisson_ratio) return *l.poisson_ratio;
+  if (role == Role::Wall && material.wall_poisson_ratio) return *material.wall_poisson_ratio;
+  if (role == Role::Viscera && material.viscera_poisson_ratio) return *material.viscera_poisson_ratio;
+  return material.poisson_ratio;
+}
+
 double Scene::effective_volume_stiffness_kpa() const {
   if (material.volume_stiffness_kpa) return *material.volume_stiffness_kpa;
   // Kitasaka gives no value for k_v. k_v = E adds E to the lattice's bulk modulus (0.721 E, shear

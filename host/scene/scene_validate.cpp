@@ -54,6 +54,24 @@ void check_label_young(const SceneMaterial& m, const At& material) {
   }
 }
 
+// The finite elements run under Newton only (the other solvers' step sizes come from the springs), and
+// the co-rotational law has no stiffening.
+void check_material_model(const Scene& s, const At& root) {
+  const SceneMaterial& m = s.material;
+  if (m.model == MaterialModel::Msd) return;
+  if (s.solver.method != SolverMethod::Newton)
+    root.child("solver").child("method").fail_value(enum_name(s.solver.method),
+                                                    std::string("cannot solve material.model \"") + enum_name(m.model) +
+                                                        "\"; use \"newton\"");
+  if (m.model == MaterialModel::FemCorotational && m.stiffening > 0.0)
+    root.child("material").child("stiffening").fail_value(m.stiffening,
+                                                          "has no meaning for \"fem-corotational\" (a linear law); "
+                                                          "use \"fem-neohookean\" for Demiray's stiffening, or 0");
+  if (m.spring_model != SpringModel::Nonlinear)
+    root.child("material").child("spring_model").fail_value(enum_name(m.spring_model),
+                                                            "applies to the springs only; remove it with a FEM model");
+}
+
 // The view direction must exist, and `up` must not lie along it (the image's roll is then undefined).
 void check_pose(const Vec3& position, const Vec3& look_at, const Optics& o, const At& view,
                 const std::string& position_key, const std::string& look_at_key, const At& optics) {
@@ -148,6 +166,7 @@ void validate_scene(const Scene& s, const ReadContext& ctx) {
   check_role_lists(s.roles, root.child("roles"));
   check_roi(s.mesh, root.child("mesh"));
   check_label_young(s.material, root.child("material"));
+  check_material_model(s, root);
   check_transfer_function(s.render, root.child("render"));
   check_views(s.render, root.child("render"));
   check_landmarks(s.landmarks, root.child("landmarks"));

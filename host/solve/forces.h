@@ -10,12 +10,15 @@
 namespace pneumo {
 
 struct ForceModel {
+  MaterialModel material = MaterialModel::Msd;   // springs, or the finite elements of fem_element.h
+  bool mean_dilatation = true;                   // FEM: the volumetric strain averaged per cube (fem_force_field.h)
   SpringModel spring_model = SpringModel::Nonlinear;
   bool damping = true;                 // spring dampers c (§4)
   double pressure_pa = 0.0;            // gas pressure on the cavity faces (mesh.h)
   double volume_stiffness_pa = 0.0;    // Kitasaka's k_v; 0 = off
   Vec3 gravity_m_s2 = Vec3::Zero();    // option (Bano); zero = off
-  double stiffening = 0.0;             // b of the exponential spring law (stiffened_strain); 0 = linear
+  double stiffening = 0.0;             // b of the exponential spring law (stiffened_strain), or of
+                                       // Demiray's law for fem-neohookean; 0 = linear / neo-Hookean
 };
 
 /// The strain-stiffening spring law (material.stiffening, docs/fidelity.md): a nonlinear spring's

@@ -12,6 +12,7 @@ SolveResult solve_explicit(const Mesh& m, const SolveOptions& opt, std::vector<V
 SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x);
 SolveResult solve_kitasaka2004(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x);
 SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x);
+SolveResult solve_newton(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x);
 
 double stable_time_step(const Mesh& m, bool damping) {
   std::vector<double> ksum(m.node_count(), 0.0), csum(m.node_count(), 0.0);
@@ -39,6 +40,8 @@ double ramp_factor(double t_s, double ramp_s, RampShape shape) {
 SolveOptions solve_options_from_scene(const Scene& s) {
   SolveOptions o;
   o.method = s.solver.method;
+  o.forces.material = s.material.model;
+  o.forces.mean_dilatation = s.material.mean_dilatation;
   o.forces.spring_model = s.material.spring_model;
   o.forces.stiffening = s.material.stiffening;
   o.forces.pressure_pa = units::mmhg_to_pa(s.load.pressure_mmhg);
@@ -56,6 +59,7 @@ SolveOptions solve_options_from_scene(const Scene& s) {
   o.newmark_gamma = s.solver.newmark_gamma;
   o.newmark_inner_tolerance = s.solver.newmark_inner_tolerance;
   o.newmark_max_inner = s.solver.newmark_max_inner;
+  o.newton_max_cg_iterations = s.solver.newton_max_cg_iterations;
   o.kitasaka_step = s.solver.kitasaka_step;
   o.kitasaka_tolerance_m = s.solver.kitasaka_tolerance_mm * units::kMetresPerMm;
   o.on_inverted = s.solver.on_inverted;
@@ -69,6 +73,7 @@ SolveResult solve(const Mesh& m, const SolveOptions& opt, const std::vector<Vec3
     case SolverMethod::Newmark: return solve_newmark(m, opt, std::move(x));
     case SolverMethod::Kitasaka2004: return solve_kitasaka2004(m, opt, std::move(x));
     case SolverMethod::Static: return solve_static_fire(m, opt, std::move(x));
+    case SolverMethod::Newton: return solve_newton(m, opt, std::move(x));
   }
   throw std::logic_error("unknown solver");
 }

@@ -318,6 +318,7 @@ SolveResult solve_opencl(ocl::Context& ctx, const Mesh& m, const SolveOptions& o
     case SolverMethod::Newmark: return newmark_cl(ctx, m, opt, x0);
     case SolverMethod::Kitasaka2004: return kitasaka_cl(ctx, m, opt, x0);
     case SolverMethod::Static: return static_fire_cl(ctx, m, opt, x0);
+    case SolverMethod::Newton: break;   // CPU only: solve_on_device() does not send it here
   }
   throw std::logic_error("unknown solver");
 }

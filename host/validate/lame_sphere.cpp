@@ -61,6 +61,7 @@ PlacementMeans solve_placement(const LameOptions& o, const Vec3& offset_cubes) {
   const double E = units::kpa_to_pa(o.young_kpa);
   Mesh m = build_mesh(VoxelRoles{g, roles.data(), nullptr}, mo, [&](Role, int) { return E; });
   assign_material(m, MaterialOptions{});
+  m.tet_poisson.assign(m.tets.size(), o.poisson);
   // Nothing is held: the pressure on the closed cavity has no net force, and a rigid drift has no
   // mean radial component over a closed surface.
 
@@ -85,7 +86,9 @@ PlacementMeans solve_placement(const LameOptions& o, const Vec3& offset_cubes) {
   }
 
   SolveOptions so;
-  so.method = SolverMethod::Static;
+  so.method = o.model == MaterialModel::Msd ? SolverMethod::Static : SolverMethod::Newton;
+  so.forces.material = o.model;
+  so.forces.mean_dilatation = o.mean_dilatation;
   so.forces.pressure_pa = units::mmhg_to_pa(o.pressure_mmhg) * o.solve_fraction;
   so.residual_tolerance = o.residual_tolerance;
   so.max_steps = 500000;
@@ -143,10 +146,16 @@ LameResult validate_lame_sphere(const LameOptions& o) {
   const double a = o.inner_mm, b = o.outer_mm;
   const double p = units::mmhg_to_pa(o.pressure_mmhg) * 1e-3;   // kPa, with E in kPa and radii in mm: u in mm
   const double Ek = o.young_kpa;
-  out.u_inner_analytic_mm = lame_sphere_u(a, a, b, p, Ek / 1.5, Ek / 2.5);   // ν = 1/4: K = E/1.5, G = E/2.5
-  out.u_outer_analytic_mm = lame_sphere_u(b, a, b, p, Ek / 1.5, Ek / 2.5);
-  out.u_inner_lattice_mm = lame_sphere_u(a, a, b, p, 0.721 * Ek, 0.432 * Ek);   // §4 lattice moduli
-  out.u_outer_lattice_mm = lame_sphere_u(b, a, b, p, 0.721 * Ek, 0.432 * Ek);
+  // The springs' ν is 1/4 (K = E/1.5, G = E/2.5) and their lattice moduli those of §4; the finite
+  // elements' are the nominal K = E/(3(1 − 2ν)), G = E/(2(1 + ν)).
+  const bool springs = o.model == MaterialModel::Msd;
+  const double nu = springs ? 0.25 : o.poisson;
+  const double K = Ek / (3.0 * (1.0 - 2.0 * nu)), G = Ek / (2.0 * (1.0 + nu));
+  const double K_model = springs ? 0.721 * Ek : K, G_model = springs ? 0.432 * Ek : G;
+  out.u_inner_analytic_mm = lame_sphere_u(a, a, b, p, K, G);
+  out.u_outer_analytic_mm = lame_sphere_u(b, a, b, p, K, G);
+  out.u_inner_lattice_mm = lame_sphere_u(a, a, b, p, K_model, G_model);
+  out.u_outer_lattice_mm = lame_sphere_u(b, a, b, p, K_model, G_model);
   out.rel_error_inner = out.u_inner_mm / out.u_inner_analytic_mm - 1.0;
   out.rel_error_outer = out.u_outer_mm / out.u_outer_analytic_mm - 1.0;
   out.rel_error_inner_lattice = out.u_inner_mm / out.u_inner_lattice_mm - 1.0;
@@ -156,7 +165,10 @@ LameResult validate_lame_sphere(const LameOptions& o) {
 }
 
 nlohmann::json to_json(const LameResult& r) {
-  return {{"cube_mm", r.options.cube_mm},
+  return {{"model", enum_name(r.options.model)},
+          {"poisson_ratio", r.options.model == MaterialModel::Msd ? 0.25 : r.options.poisson},
+          {"mean_dilatation", r.options.mean_dilatation},
+          {"cube_mm", r.options.cube_mm},
           {"voxel_mm", r.options.voxel_mm > 0 ? r.options.voxel_mm : r.options.cube_mm},
           {"inner_radius_mm", r.options.inner_mm},
           {"outer_radius_mm", r.options.outer_mm},
@@ -170,8 +182,8 @@ nlohmann::json to_json(const LameResult& r) {
           {"u_outer_analytic_mm", r.u_outer_analytic_mm},
           {"rel_error_inner", r.rel_error_inner},
           {"rel_error_outer", r.rel_error_outer},
-          {"lattice_bulk_over_e", 0.721},
-          {"lattice_shear_over_e", 0.432},
+          {"lattice_bulk_over_e", r.options.model == MaterialModel::Msd ? nlohmann::json(0.721) : nlohmann::json(nullptr)},
+          {"lattice_shear_over_e", r.options.model == MaterialModel::Msd ? nlohmann::json(0.432) : nlohmann::json(nullptr)},
           {"u_inner_lattice_mm", r.u_inner_lattice_mm},
           {"u_outer_lattice_mm", r.u_outer_lattice_mm},
           {"rel_error_inner_lattice", r.rel_error_inner_lattice},

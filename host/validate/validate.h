@@ -21,14 +21,14 @@ struct LatticeResult {
 };
 LatticeResult validate_lattice(int cubes_across = 6, double cube_mm = 5.0);
 
-/// §10: hollow sphere (inner radius a, outer b), internal pressure p, E, ν = 1/4, voxelised and meshed
+/// §10: hollow sphere (inner radius a, outer b), internal pressure p, E, ν (1/4 for the springs), voxelised and meshed
 /// whole. The radial displacement is averaged over the inner and outer boundary surfaces (each node
 /// weighted by its share of the boundary's area: the surface mean of the mesh's displacement) and
 /// then over `placements` positions of the sphere's centre relative to the lattice: the staircase a
 /// single placement cuts scatters the means by a few percent at 10 mm cubes (an aligned placement,
 /// centred on a node, is the worst: +11.5 % inner), which is aliasing, not convergence. Compared
 /// against the nominal closed form and against the lattice's own moduli (bulk 0.721·E, shear
-/// 0.432·E). Linear elasticity is a small-strain theory, so the model is solved at `solve_fraction`
+/// 0.432·E; for the finite elements these are the nominal moduli). Linear elasticity is a small-strain theory, so the model is solved at `solve_fraction`
 /// of the pressure (geometric nonlinearity below 0.5 %) and scaled back to p.
 struct LameOptions {
   double cube_mm = 5.0;
@@ -39,6 +39,9 @@ struct LameOptions {
   double solve_fraction = 0.1;
   double residual_tolerance = 1e-6;
   int placements = 4;                // centres from lame_placement(0 … placements − 1)
+  MaterialModel model = MaterialModel::Msd;   // the finite elements are solved by Newton
+  double poisson = 0.25;             // the finite elements' ν (the springs' is 1/4 whatever this says)
+  bool mean_dilatation = true;
 };
 struct LameResult {
   LameOptions options;

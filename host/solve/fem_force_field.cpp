@@ -1,0 +1,222 @@
+// The tetrahedral finite elements (fem_element.h) as a ForceField: the CPU reference, double precision.
+//
+// Each tetrahedron t has Lamé's μ_t, λ_t from its Young's modulus (the Voigt average over the tissue
+// that fills it, mesh.h) and its Poisson ratio, and the law's volumetric modulus κ_t. Against the
+// volumetric locking of linear tetrahedra at ν → ½, the dilatation is averaged over the tetrahedra
+// of one cube and part (a mean-dilatation or B-bar treatment, Nagtegaal et al. 1974; Hughes 1980):
+// with the weights w_t = κ_t V_t and Λ_c = Σ w_t,
+//   ē_c = Σ_t w_t e_t / Λ_c,   E_vol = ½ Λ_c ē_c²,
+// so tetrahedron t feels the volumetric stress κ_t ē_c G_t instead of κ_t e_t G_t. A uniform strain
+// has ē_c = e_t, so the patch test still holds; the deviatoric part stays per tetrahedron, so no
+// zero-energy mode appears. With ForceModel::mean_dilatation = false each tetrahedron is its own group.
+//
+// The stiffness product for a direction p (δF_t = δD_s D_m⁻¹):
+//   δP_t = δP_d,t + κ_t δē_c G_t + κ_t ē_c δG_t,   δē_c = Σ_s w_s (G_s : δF_s) / Λ_c,
+// gathered as K p = V_t δP_t D_m⁻ᵀ per vertex (the nodal forces' derivative, sign flipped).
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "solve/fem_element.h"
+#include "solve/force_field.h"
+
+namespace pneumo {
+
+namespace {
+
+FemLaw law_of(MaterialModel m) {
+  return m == MaterialModel::FemNeoHookean ? FemLaw::NeoHookean : FemLaw::Corotational;
+}
+
+class FemForceField final : public ForceField {
+ public:
+  explicit FemForceField(const Mesh& m, FemLaw law) : m_(m), law_(law), adj_(Adjacency::of(m)) {
+    const int64_t T = int64_t(m.tets.size());
+    rest_.resize(T);
+    lame_.resize(T);
+    kappa_.resize(T);
+    for (int64_t t = 0; t < T; ++t) {
+      const auto& q = m.tets[t];
+      rest_[t] = tet_rest(m.rest_m[q[0]], m.rest_m[q[1]], m.rest_m[q[2]], m.rest_m[q[3]]);
+      const double nu = m.tet_poisson.empty() ? 0.25 : m.tet_poisson[t];
+      lame_[t] = Lame::from_young_poisson(m.tet_young_pa[t], nu);
+      kappa_[t] = volumetric_modulus(law, lame_[t]);
+    }
+  }
+
+  void evaluate(const ForceModel& model, const std::vector<Vec3>& x, const std::vector<Vec3>&,
+                std::vector<Vec3>& f) override {
+    // Velocities are not used: the finite elements carry no damping (the static and Newton solvers
+    // need none).
+    update_states(model, x);
+    const int64_t T = int64_t(m_.tets.size()), R = int64_t(m_.load_tet.size()), N = m_.node_count();
+    tet_f_.resize(4 * T);
+#pragma omp parallel for schedule(static) if (T > 20000)
+    for (int64_t t = 0; t < T; ++t) {
+      const ElementState& s = state_[t];
+      const Mat3 P = deviatoric_piola(s, lame_[t]) + kappa_[t] * ebar_[group_of_tet_[t]] * dilatation_gradient(s);
+      const auto fe = nodal_forces(P, rest_[t]);
+      for (int i = 0; i < 4; ++i) tet_f_[4 * t + i] = fe[i];
+    }
+    load_f_.resize(model.pressure_pa != 0.0 ? 4 * R : 0);
+    if (!load_f_.empty()) {
+#pragma omp parallel for schedule(static) if (R > 20000)
+      for (int64_t r = 0; r < R; ++r) {
+        const auto fl = pressure_load_forces(m_, r, x, model.pressure_pa);
+        for (int i = 0; i < 4; ++i) load_f_[4 * r + i] = fl[i];
+      }
+    }
+    f.resize(N);
+#pragma omp parallel for schedule(static) if (N > 20000)
+    for (int64_t n = 0; n < N; ++n) {
+      Vec3 sum = model.gravity_m_s2 * (m_.mass_kg.empty() ? 0.0 : m_.mass_kg[n]);
+      sum += gather(adj_.tets, n, tet_f_);
+      if (!load_f_.empty()) sum += gather(adj_.loads, n, load_f_);
+      f[n] = sum;
+    }
+    ++evaluations_;
+  }
+
+  double elastic_energy(const ForceModel& model, const std::vector<Vec3>& x) override {
+    update_states(model, x);
+    double e = 0.0;
+    for (std::size_t t = 0; t < m_.tets.size(); ++t) e += rest_[t].volume_m3 * deviatoric_energy_density(state_[t], lame_[t]);
+    for (std::size_t g = 0; g < ebar_.size(); ++g) e += 0.5 * group_weight_[g] * ebar_[g] * ebar_[g];
+    return e;
+  }
+
+  void linearize(const ForceModel& model, const std::vector<Vec3>& x) override { update_states(model, x); }
+
+  void stiffness_product(const std::vector<Vec3>& p, std::vector<Vec3>& kp) override {
+    const int64_t T = int64_t(m_.tets.size()), G = int64_t(group_weight_.size()), N = m_.node_count();
+    dF_.resize(T);
+#pragma omp parallel for schedule(static) if (T > 20000)
+    for (int64_t t = 0; t < T; ++t) {
+      const auto& q = m_.tets[t];
+      dF_[t] = edge_matrix(p[q[0]], p[q[1]], p[q[2]], p[q[3]]) * rest_[t].dm_inverse;
+    }
+    debar_.assign(G, 0.0);
+#pragma omp parallel for schedule(static) if (G > 20000)
+    for (int64_t g = 0; g < G; ++g) {
+      double sum = 0.0;
+      for (int32_t i = group_begin_[g]; i < group_begin_[g + 1]; ++i) {
+        const int32_t t = group_tets_[i];
+        sum += kappa_[t] * rest_[t].volume_m3 * dilatation_gradient(state_[t]).cwiseProduct(dF_[t]).sum();
+      }
+      debar_[g] = group_weight_[g] > 0.0 ? sum / group_weight_[g] : 0.0;
+    }
+    tet_f_.resize(4 * T);
+#pragma omp parallel for schedule(static) if (T > 20000)
+    for (int64_t t = 0; t < T; ++t) {
+      const ElementState& s = state_[t];
+      const int32_t g = group_of_tet_[t];
+      const Mat3 dP = deviatoric_dpiola(s, dF_[t], lame_[t]) +
+                      kappa_[t] * (debar_[g] * dilatation_gradient(s) + ebar_[g] * dilatation_dgradient(s, dF_[t]));
+      const auto fe = nodal_forces(dP, rest_[t]);   // −V₀ δP D_m⁻ᵀ: the forces' change, −K p
+      for (int i = 0; i < 4; ++i) tet_f_[4 * t + i] = -fe[i];
+    }
+    kp.resize(N);
+#pragma omp parallel for schedule(static) if (N > 20000)
+    for (int64_t n = 0; n < N; ++n) kp[n] = gather(adj_.tets, n, tet_f_);
+  }
+
+  void stiffness_diagonal(std::vector<Mat3>& blocks) override {
+    // K_ii per tetrahedron from unit moves of vertex i along each axis, with the tetrahedron's own
+    // dilatation (the cube coupling left out: this is only the preconditioner).
+    blocks.assign(m_.node_count(), Mat3::Zero());
+    for (std::size_t t = 0; t < m_.tets.size(); ++t) {
+      const Mat3& Dinv = rest_[t].dm_inverse;
+      // ∂F/∂x_i along axis a is e_a ⊗ ∇N_i, with ∇N_i the rows of D_m⁻¹ (vertex 0: minus their sum).
+      const Vec3 grads[4] = {-(Dinv.row(0) + Dinv.row(1) + Dinv.row(2)).transpose(), Dinv.row(0).transpose(),
+                             Dinv.row(1).transpose(), Dinv.row(2).transpose()};
+      for (int i = 0; i < 4; ++i)
+        for (int a = 0; a < 3; ++a) {
+          const Mat3 dF = Vec3::Unit(a) * grads[i].transpose();
+          const Vec3 col = rest_[t].volume_m3 * dpiola(state_[t], dF, lame_[t]) * grads[i];
+          blocks[m_.tets[t][i]].col(a) += col;
+        }
+    }
+  }
+
+  int64_t evaluations() const override { return evaluations_; }
+
+ private:
+  static Vec3 gather(const Csr& csr, int64_t n, const std::vector<Vec3>& per_vertex) {
+    Vec3 sum = Vec3::Zero();
+    for (int64_t e = csr.begin(n); e < csr.end(n); ++e) {
+      const int32_t it = csr.item[e];
+      sum += per_vertex[4 * (it / 8) + it % 8];
+    }
+    return sum;
+  }
+
+  // The groups of the mean dilatation: the tetrahedra of one cube and part, or each alone.
+  void build_groups(bool mean_dilatation) {
+    const int64_t T = int64_t(m_.tets.size());
+    std::vector<int32_t> order(T);
+    std::iota(order.begin(), order.end(), 0);
+    auto key = [&](int32_t t) { return mean_dilatation ? m_.tet_cube[t] * 2 + int64_t(m_.tet_part[t]) : int64_t(t); };
+    std::stable_sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return key(a) < key(b); });
+    group_of_tet_.assign(T, 0);
+    group_tets_ = order;
+    group_begin_.clear();
+    for (int64_t i = 0; i < T; ++i) {
+      if (i == 0 || key(order[i]) != key(order[i - 1])) group_begin_.push_back(int32_t(i));
+      group_of_tet_[order[i]] = int32_t(group_begin_.size() - 1);
+    }
+    group_begin_.push_back(int32_t(T));
+    group_weight_.assign(group_begin_.size() - 1, 0.0);
+    for (int64_t t = 0; t < T; ++t) group_weight_[group_of_tet_[t]] += kappa_[t] * rest_[t].volume_m3;
+    grouped_by_cube_ = mean_dilatation;
+    groups_built_ = true;
+  }
+
+  void update_states(const ForceModel& model, const std::vector<Vec3>& x) {
+    if (!groups_built_ || grouped_by_cube_ != model.mean_dilatation) build_groups(model.mean_dilatation);
+    const int64_t T = int64_t(m_.tets.size()), G = int64_t(group_weight_.size());
+    if (law_of(model.material) != law_)
+      throw std::logic_error("FemForceField: built for one law, asked for another");
+    const FemLaw law = law_;
+    state_.resize(T);
+#pragma omp parallel for schedule(static) if (T > 20000)
+    for (int64_t t = 0; t < T; ++t) {
+      const auto& q = m_.tets[t];
+      const Mat3 F = edge_matrix(x[q[0]], x[q[1]], x[q[2]], x[q[3]]) * rest_[t].dm_inverse;
+      state_[t] = element_state(law, F, model.stiffening);
+    }
+    ebar_.assign(G, 0.0);
+#pragma omp parallel for schedule(static) if (G > 20000)
+    for (int64_t g = 0; g < G; ++g) {
+      double sum = 0.0;
+      for (int32_t i = group_begin_[g]; i < group_begin_[g + 1]; ++i) {
+        const int32_t t = group_tets_[i];
+        // An inverted neo-Hookean element has no dilatation: NaN reaches its forces and the solver.
+        sum += kappa_[t] * rest_[t].volume_m3 * (state_[t].valid ? state_[t].e : NAN);
+      }
+      ebar_[g] = group_weight_[g] > 0.0 ? sum / group_weight_[g] : 0.0;
+    }
+  }
+
+  const Mesh& m_;
+  FemLaw law_;
+  Adjacency adj_;
+  std::vector<TetRest> rest_;
+  std::vector<Lame> lame_;
+  std::vector<double> kappa_;   // volumetric modulus of the law (fem_element.h), per tetrahedron
+  std::vector<ElementState> state_;
+  std::vector<int32_t> group_of_tet_, group_tets_, group_begin_;
+  std::vector<double> group_weight_, ebar_, debar_;
+  std::vector<Mat3> dF_;
+  std::vector<Vec3> tet_f_, load_f_;
+  bool groups_built_ = false, grouped_by_cube_ = false;
+  int64_t evaluations_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<ForceField> make_fem_force_field(const Mesh& m, MaterialModel model) {
+  return std::make_unique<FemForceField>(m, law_of(model));
+}
+
+}  // namespace pneumo

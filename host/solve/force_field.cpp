@@ -1,0 +1,17 @@
+// The one place a material model is chosen (force_field.h).
+#include "solve/force_field.h"
+
+#include <stdexcept>
+
+namespace pneumo {
+
+std::unique_ptr<ForceField> make_force_field(const Mesh& m, const ForceModel& model) {
+  switch (model.material) {
+    case MaterialModel::Msd: return make_spring_force_field(m);
+    case MaterialModel::FemCorotational:
+    case MaterialModel::FemNeoHookean: return make_fem_force_field(m, model.material);
+  }
+  throw std::logic_error("unknown material model");
+}
+
+}  // namespace pneumo

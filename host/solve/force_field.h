@@ -1,0 +1,46 @@
+#pragma once
+// One interface for every material model's forces on the mesh (issue "One shape for every stage"):
+// the springs of method.md §5 (spring_force_field.cpp) and the tetrahedral finite elements
+// (fem_force_field.cpp) implement it, and the solvers see only this. A new material model is a new
+// implementation and one line in make_force_field().
+//
+// Besides the forces, a model offers its linearisation for the Newton solver: the stiffness
+// K = −∂f_elastic/∂x at a state, as a matrix-free product and as the 3×3 blocks of its diagonal
+// (the preconditioner). The pressure's follower load and gravity are not in K (solve_newton.cpp
+// says why). Units: metres, newtons, joules.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "mesh/mesh.h"
+#include "solve/forces.h"
+
+namespace pneumo {
+
+class ForceField {
+ public:
+  virtual ~ForceField() = default;
+  /// Every force term of `model` at positions x and velocities v (v may be empty: no damping), one
+  /// entry per node; held axes are not zeroed (the solvers do that).
+  virtual void evaluate(const ForceModel& model, const std::vector<Vec3>& x, const std::vector<Vec3>& v,
+                        std::vector<Vec3>& f) = 0;
+  /// The elastic energy at x (J): what the elastic forces are minus the gradient of.
+  virtual double elastic_energy(const ForceModel& model, const std::vector<Vec3>& x) = 0;
+  /// Prepares stiffness_product and stiffness_diagonal at x.
+  virtual void linearize(const ForceModel& model, const std::vector<Vec3>& x) = 0;
+  /// kp = K p at the last linearisation.
+  virtual void stiffness_product(const std::vector<Vec3>& p, std::vector<Vec3>& kp) = 0;
+  /// The 3×3 diagonal blocks K_nn at the last linearisation, one per node.
+  virtual void stiffness_diagonal(std::vector<Mat3>& blocks) = 0;
+  /// Force evaluations so far (stiffness products not counted).
+  virtual int64_t evaluations() const = 0;
+};
+
+/// The force field of `model.material` on mesh m.
+std::unique_ptr<ForceField> make_force_field(const Mesh& m, const ForceModel& model);
+
+/// The implementations (what make_force_field picks from).
+std::unique_ptr<ForceField> make_spring_force_field(const Mesh& m);
+std::unique_ptr<ForceField> make_fem_force_field(const Mesh& m, MaterialModel model);
+
+}  // namespace pneumo

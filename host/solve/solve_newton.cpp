@@ -1,0 +1,165 @@
+// Static equilibrium by Newton's method with matrix-free preconditioned conjugate gradients, on any
+// force field (force_field.h): the springs or the finite elements (issue "Bano's row").
+//
+// Each Newton iteration solves K d = f(x) for the step d, with K the elastic stiffness at x, by CG
+// preconditioned with the inverse 3×3 diagonal blocks of K (block Jacobi), to a relative residual η
+// chosen as Eisenstat & Walker (1996, choice 2: η = 0.9 (|f_k|/|f_{k−1}|)², within [10⁻³, 0.1]), so
+// early iterations are cheap and late ones converge fast. CG stops at a direction of non-positive
+// curvature (compressed springs, a buckling element) and keeps what it has, or the preconditioned
+// force on the first iteration. A backtracking line search halves the step until |f| falls
+// (sufficient decrease, 10⁻⁴) and no further tetrahedron inverts.
+//
+// Why K leaves out the pressure: the gas pressure is a follower load whose derivative is not
+// symmetric, and CG needs a symmetric matrix. Leaving it out makes this a modified Newton method that
+// converges linearly at a rate near the ratio of the pressure's stiffness to the tissue's (P/E, small
+// at surgical pressures: 1.6 kPa against a wall of tens of kPa), with the line search keeping it
+// safe. The load is applied in the static solver's increments, each solved before the next.
+#include <algorithm>
+#include <cmath>
+
+#include "solve/force_field.h"
+#include "solve/solver_common.h"
+
+namespace pneumo {
+
+namespace {
+
+double dot(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  double s = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) s += a[i].dot(b[i]);
+  return s;
+}
+
+// The inverse of each node's diagonal block on its free axes (held axes: zero rows and columns).
+std::vector<Mat3> block_jacobi(const Mesh& m, const std::vector<Mat3>& blocks) {
+  std::vector<Mat3> inv(blocks.size());
+  for (std::size_t n = 0; n < blocks.size(); ++n) {
+    Mat3 b = blocks[n];
+    for (int a = 0; a < 3; ++a)
+      if (m.hold[n] & (1 << a)) { b.row(a).setZero(); b.col(a).setZero(); b(a, a) = 1.0; }
+    Mat3 i;
+    bool ok = false;
+    double det = 0.0;
+    b.computeInverseAndDetWithCheck(i, det, ok);
+    // A block that is not positive (a node of compressed springs only) falls back to its diagonal.
+    if (!ok || !(det > 0.0) || !i.allFinite()) {
+      i.setZero();
+      for (int a = 0; a < 3; ++a) i(a, a) = b(a, a) > 0.0 ? 1.0 / b(a, a) : 0.0;
+    }
+    for (int a = 0; a < 3; ++a)
+      if (m.hold[n] & (1 << a)) { i.row(a).setZero(); i.col(a).setZero(); }
+    inv[n] = i;
+  }
+  return inv;
+}
+
+struct CgOutcome {
+  int iterations = 0;
+  bool negative_curvature = false;
+};
+
+// Solves K d = f to |f − K d| ≤ η |f| on the free axes.
+CgOutcome conjugate_gradients(const Mesh& m, ForceField& field, const std::vector<Mat3>& precond,
+                              const std::vector<Vec3>& f, double eta, int max_iterations, std::vector<Vec3>& d) {
+  const std::size_t N = f.size();
+  CgOutcome out;
+  std::vector<Vec3> r = f, z(N), p(N), kp;
+  d.assign(N, Vec3::Zero());
+  for (std::size_t n = 0; n < N; ++n) z[n] = precond[n] * r[n];
+  p = z;
+  double rz = dot(r, z);
+  const double stop = eta * std::sqrt(dot(f, f));
+  for (int it = 0; it < max_iterations; ++it) {
+    field.stiffness_product(p, kp);
+    detail::apply_holds(m, kp);
+    const double pkp = dot(p, kp);
+    if (!(pkp > 0.0)) {
+      out.negative_curvature = true;
+      if (it == 0) d = z;   // the preconditioned force: still a descent direction
+      break;
+    }
+    const double a = rz / pkp;
+    for (std::size_t n = 0; n < N; ++n) { d[n] += a * p[n]; r[n] -= a * kp[n]; }
+    out.iterations = it + 1;
+    if (std::sqrt(dot(r, r)) <= stop) break;
+    for (std::size_t n = 0; n < N; ++n) z[n] = precond[n] * r[n];
+    const double rz_next = dot(r, z);
+    const double beta = rz_next / rz;
+    rz = rz_next;
+    for (std::size_t n = 0; n < N; ++n) p[n] = z[n] + beta * p[n];
+  }
+  return out;
+}
+
+}  // namespace
+
+SolveResult solve_newton(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x) {
+  SolveResult r;
+  detail::Monitor mon(m, opt, "newton", r);
+  const int64_t N = m.node_count();
+  const std::unique_ptr<ForceField> field = make_force_field(m, opt.forces);
+  ForceModel model = opt.forces;
+  model.damping = false;
+  const int increments = detail::load_increments(opt);
+  const std::string advice = detail::kLoadAdvice;
+
+  std::vector<Vec3> f, trial(N), f_trial, d;
+  std::vector<Mat3> blocks;
+  int64_t step = 0, cg_iterations = 0;
+  double residual = INFINITY;
+  bool converged = false;
+  std::string reason = "step limit";
+  for (int inc = 1; inc <= increments; ++inc) {
+    model.pressure_pa = detail::increment_pressure(opt, inc, increments);
+    const bool last = inc == increments;
+    const double tol = opt.residual_tolerance * (last ? 1.0 : detail::Fire::kIntermediateToleranceFactor);
+    field->evaluate(model, x, {}, f);
+    detail::apply_holds(m, f);
+    residual = mon.residual(f);
+    double norm = std::sqrt(dot(f, f)), previous_norm = NAN;
+    int64_t inverted = count_inverted(m, x);
+    bool increment_done = residual < tol;
+    while (!increment_done && step < opt.max_steps) {
+      field->linearize(model, x);
+      field->stiffness_diagonal(blocks);
+      const std::vector<Mat3> precond = block_jacobi(m, blocks);
+      const double eta = std::isfinite(previous_norm)
+                             ? std::clamp(0.9 * (norm / previous_norm) * (norm / previous_norm), 1e-3, 0.1)
+                             : 0.1;
+      const CgOutcome cg = conjugate_gradients(m, *field, precond, f, eta, opt.newton_max_cg_iterations, d);
+      cg_iterations += cg.iterations;
+
+      // Backtracking on |f|: halve until it falls enough and no further tetrahedron inverts.
+      double alpha = 1.0, trial_norm = INFINITY;
+      bool accepted = false;
+      for (int tries = 0; tries < 12 && !accepted; ++tries, alpha *= 0.5) {
+        for (int64_t n = 0; n < N; ++n) trial[n] = x[n] + alpha * d[n];
+        field->evaluate(model, trial, {}, f_trial);
+        detail::apply_holds(m, f_trial);
+        trial_norm = std::sqrt(dot(f_trial, f_trial));
+        accepted = std::isfinite(trial_norm) && trial_norm <= (1.0 - 1e-4 * alpha) * norm &&
+                   count_inverted(m, trial) <= inverted;
+      }
+      if (!accepted) { reason = "no descent"; break; }
+      x.swap(trial);
+      f.swap(f_trial);
+      previous_norm = norm;
+      norm = trial_norm;
+      inverted = count_inverted(m, x);
+      ++step;
+      mon.check_diverged(x, step, advice);
+      residual = mon.residual(f);
+      if (mon.record(step, 0.0, model.pressure_pa, residual, x, {})) { reason = "inverted tetrahedra"; break; }
+      increment_done = residual < tol;
+    }
+    if (reason == "inverted tetrahedra" || reason == "no descent") break;
+    if (last && increment_done) { converged = true; reason = "converged"; }
+    if (!increment_done) break;
+  }
+  r.final_pressure_pa = model.pressure_pa;
+  r.inner_iterations = cg_iterations;
+  mon.finish(x, {}, step, field->evaluations(), converged, reason, residual);
+  return r;
+}
+
+}  // namespace pneumo

@@ -1,0 +1,20 @@
+#pragma once
+// The one entry through which the pipeline and the benchmarks solve (issue "One shape for every
+// stage"): the device is chosen here, not by each caller. A new back end is a new case here.
+#include <vector>
+
+#include "cl/cl_runtime.h"
+#include "solve/solver.h"
+
+namespace pneumo {
+
+/// Whether the OpenCL solvers (solver_cl.h) implement this method and material model: the four
+/// spring solvers do; Newton and the finite elements run on the CPU.
+bool device_implements(const SolveOptions& opt);
+
+/// Solves on `ctx` when it is given and implements the options, on the CPU otherwise (saying so
+/// once per process when a device was asked for).
+SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions& opt,
+                            const std::vector<Vec3>& x_start = {});
+
+}  // namespace pneumo

@@ -1,0 +1,344 @@
+// The finite elements (solve/fem_element.h, the FEM force field) against truths computed here:
+// rotations carry no stress, the stress is the energy's gradient and the stiffness product the
+// forces' Jacobian (central finite differences), small strains obey Hooke's law, and a uniform
+// strain is reproduced exactly (the patch test). The same derivative checks hold for the springs'
+// stiffness, which the Newton solver uses too.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "core/progress.h"
+#include "mesh/mesh.h"
+#include "solve/fem_element.h"
+#include "solve/force_field.h"
+#include "solve/solver.h"
+#include "validate/validate.h"
+
+namespace pneumo {
+namespace {
+
+const uint32_t kSeed = 20261202u;
+const Lame kLame = Lame::from_young_poisson(60e3, 0.45);
+
+Mat3 rotation(const Vec3& axis, double angle) { return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix(); }
+
+Mat3 random_matrix(std::mt19937& rng, double amplitude) {
+  std::uniform_real_distribution<double> u(-amplitude, amplitude);
+  Mat3 m;
+  for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = u(rng);
+  return m;
+}
+
+struct LawCase {
+  FemLaw law;
+  double b;
+  const char* name;
+};
+const LawCase kLaws[] = {{FemLaw::Corotational, 0.0, "corotational"},
+                         {FemLaw::NeoHookean, 0.0, "neo-Hookean"},
+                         {FemLaw::NeoHookean, 4.0, "Demiray b=4"}};
+
+TEST(FemElement, PolarDecompositionIsARotationTimesASymmetricStretch) {
+  // Compared: R S against F, RᵀR against I, det R against +1 and S against Sᵀ, for random F and for
+  // an inverted F (det < 0), which must keep a proper rotation. Tolerance 1e-12: rounding of a 3×3 SVD.
+  std::mt19937 rng(kSeed);
+  for (int k = 0; k < 20; ++k) {
+    Mat3 F = Mat3::Identity() + random_matrix(rng, 0.5);
+    if (k % 4 == 0) F.col(0) *= -1.0;   // inverted
+    const Polar p = polar_decomposition(F);
+    EXPECT_LT((p.R * p.S - F).norm(), 1e-12);
+    EXPECT_LT((p.R.transpose() * p.R - Mat3::Identity()).norm(), 1e-12);
+    EXPECT_NEAR(p.R.determinant(), 1.0, 1e-12);
+    EXPECT_LT((p.S - p.S.transpose()).norm(), 1e-12);
+  }
+}
+
+TEST(FemElement, RotationsOfAnySizeCarryNoStressOrEnergy) {
+  // Compared: ψ and P of a pure rotation (up to 3 rad, near a half turn) against zero, for every law.
+  // Tolerance 1e-9 of μ: rounding (a rotation is exactly stress-free in both laws).
+  for (const LawCase& c : kLaws)
+    for (double angle : {0.1, 1.0, 2.0, 3.0}) {
+      SCOPED_TRACE(std::string(c.name) + " angle " + std::to_string(angle));
+      const ElementState s = element_state(c.law, rotation(Vec3(1, 2, -0.5), angle), c.b);
+      EXPECT_LT(std::abs(energy_density(s, kLame)), 1e-9 * kLame.mu);
+      EXPECT_LT(piola(s, kLame).norm(), 1e-9 * kLame.mu);
+    }
+}
+
+TEST(FemElement, StressIsTheGradientOfTheEnergy) {
+  // Compared: P(F) against the central difference (ψ(F + hE_ij) − ψ(F − hE_ij))/2h, h = 1e-6, at random
+  // F of strains up to 30 %. Tolerance 1e-6 relative to |P|: the difference's O(h²) error and rounding.
+  std::mt19937 rng(kSeed + 1);
+  for (const LawCase& c : kLaws)
+    for (int k = 0; k < 10; ++k) {
+      SCOPED_TRACE(std::string(c.name) + " sample " + std::to_string(k));
+      const Mat3 F = rotation(Vec3(0.3, 1, 0.2), 0.7 * k) * (Mat3::Identity() + random_matrix(rng, 0.3));
+      const Mat3 P = piola(element_state(c.law, F, c.b), kLame);
+      Mat3 fd;
+      const double h = 1e-6;
+      for (int i = 0; i < 9; ++i) {
+        Mat3 Fp = F, Fm = F;
+        Fp(i / 3, i % 3) += h;
+        Fm(i / 3, i % 3) -= h;
+        fd(i / 3, i % 3) = (energy_density(element_state(c.law, Fp, c.b), kLame) -
+                            energy_density(element_state(c.law, Fm, c.b), kLame)) / (2 * h);
+      }
+      EXPECT_LT((P - fd).norm(), 1e-6 * P.norm());
+    }
+}
+
+TEST(FemElement, StressDerivativeIsTheFiniteDifferenceOfTheStress) {
+  // Compared: δP for a random δF against (P(F + hδF) − P(F − hδF))/2h, h = 1e-6; the co-rotational
+  // δP includes the rotation's derivative. Tolerance 1e-6 relative to |δP|.
+  std::mt19937 rng(kSeed + 2);
+  for (const LawCase& c : kLaws)
+    for (int k = 0; k < 10; ++k) {
+      SCOPED_TRACE(std::string(c.name) + " sample " + std::to_string(k));
+      const Mat3 F = rotation(Vec3(1, -0.4, 0.8), 0.9 * k) * (Mat3::Identity() + random_matrix(rng, 0.3));
+      const Mat3 dF = random_matrix(rng, 1.0);
+      const Mat3 dP = dpiola(element_state(c.law, F, c.b), dF, kLame);
+      const double h = 1e-6;
+      const Mat3 fd = (piola(element_state(c.law, F + h * dF, c.b), kLame) -
+                       piola(element_state(c.law, F - h * dF, c.b), kLame)) / (2 * h);
+      EXPECT_LT((dP - fd).norm(), 1e-6 * dP.norm());
+    }
+}
+
+TEST(FemElement, SmallStrainsObeyHookesLaw) {
+  // Compared: P at F = I + εH (ε = 1e-7) against Hooke's σ = 2μ sym(εH) + λ tr(εH) I. Tolerance 1e-5
+  // relative: the laws' nonlinear terms are O(ε²)/O(ε) = 1e-7, plus rounding of ε-sized differences.
+  std::mt19937 rng(kSeed + 3);
+  const Mat3 H = random_matrix(rng, 1.0);
+  const double eps = 1e-7;
+  const Mat3 strain = 0.5 * eps * (H + H.transpose());
+  const Mat3 hooke = 2 * kLame.mu * strain + kLame.lambda * strain.trace() * Mat3::Identity();
+  for (const LawCase& c : kLaws) {
+    SCOPED_TRACE(c.name);
+    EXPECT_LT((piola(element_state(c.law, Mat3::Identity() + eps * H, c.b), kLame) - hooke).norm(),
+              1e-5 * hooke.norm());
+  }
+}
+
+TEST(FemElement, InvertedNeoHookeanElementHasNoEnergy) {
+  // Compared: an inverted element (det F < 0) must be flagged, with infinite energy (the line search
+  // rejects it), where the co-rotational law pushes back with a finite stress.
+  Mat3 F = Mat3::Identity();
+  F(2, 2) = -0.1;
+  EXPECT_FALSE(element_state(FemLaw::NeoHookean, F).valid);
+  EXPECT_TRUE(std::isinf(energy_density(element_state(FemLaw::NeoHookean, F), kLame)));
+  const ElementState co = element_state(FemLaw::Corotational, F);
+  EXPECT_TRUE(std::isfinite(energy_density(co, kLame)));
+  EXPECT_GT(piola(co, kLame).norm(), 0.0);
+}
+
+// ---- on a mesh --------------------------------------------------------------------------------------------------
+
+/// A block of wall voxels (5 mm) in a shell of viscera, meshed with cubes of 2 voxels, so some cubes
+/// are partly filled (fractions and moduli vary per tetrahedron and the cube groups are uneven).
+Mesh block_mesh(int n, int cube_voxels, bool shell = true) {
+  Geometry g;
+  const int pad = shell ? 1 : 0;
+  g.dims = {n + 2 * pad, n + 2 * pad, n + 2 * pad};
+  g.spacing_mm = Vec3::Constant(5.0);
+  std::vector<Role> roles(g.voxel_count(), shell ? Role::Viscera : Role::Wall);
+  for (int k = pad; k < n + pad; ++k)
+    for (int j = pad; j < n + pad; ++j)
+      for (int i = pad; i < n + pad; ++i) roles[g.linear_index(i, j, k)] = Role::Wall;
+  MeshOptions o;
+  o.cube_voxels = cube_voxels;
+  o.model = MeshModel::Wall;
+  Mesh m = build_mesh(VoxelRoles{g, roles.data(), nullptr}, o, [](Role, int) { return 60e3; });
+  assign_material(m, MaterialOptions{});
+  m.tet_poisson.assign(m.tets.size(), 0.45);
+  return m;
+}
+
+std::vector<Vec3> perturbed(const Mesh& m, std::mt19937& rng, double amplitude_m) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Vec3> x = m.rest_m;
+  for (auto& p : x) p += amplitude_m * Vec3(u(rng), u(rng), u(rng));
+  return x;
+}
+
+double max_norm(const std::vector<Vec3>& f) {
+  double s = 0.0;
+  for (const auto& v : f) s = std::max(s, v.norm());
+  return s;
+}
+
+struct FieldCase {
+  MaterialModel model;
+  bool mean_dilatation;
+  double b;
+  const char* name;
+};
+const FieldCase kFields[] = {{MaterialModel::FemCorotational, true, 0.0, "corotational, mean dilatation"},
+                             {MaterialModel::FemCorotational, false, 0.0, "corotational, per tetrahedron"},
+                             {MaterialModel::FemNeoHookean, true, 0.0, "neo-Hookean, mean dilatation"},
+                             {MaterialModel::FemNeoHookean, false, 3.0, "Demiray, per tetrahedron"},
+                             {MaterialModel::Msd, true, 0.0, "springs"},
+                             {MaterialModel::Msd, true, 5.0, "stiffening springs"}};
+
+ForceModel elastic_only(const FieldCase& c) {
+  ForceModel fm;
+  fm.material = c.model;
+  fm.mean_dilatation = c.mean_dilatation;
+  fm.stiffening = c.b;
+  fm.damping = false;
+  return fm;
+}
+
+TEST(FemField, ForcesAreMinusTheGradientOfTheElasticEnergy) {
+  // Compared: each node's force against the central difference of the field's elastic energy (step
+  // 1e-8 m) at a random state (nodes moved up to 0.5 mm of 10 mm cubes), with the cube-averaged
+  // dilatation and without. Tolerance 1e-5 of the largest force: the difference's error and rounding.
+  std::mt19937 rng(kSeed + 4);
+  const Mesh m = block_mesh(4, 2);
+  const std::vector<Vec3> x = perturbed(m, rng, 0.5e-3);
+  for (const FieldCase& c : kFields) {
+    SCOPED_TRACE(c.name);
+    const ForceModel fm = elastic_only(c);
+    auto field = make_force_field(m, fm);
+    std::vector<Vec3> f;
+    field->evaluate(fm, x, {}, f);
+    double worst = 0.0;
+    for (int64_t i = 0; i < m.node_count(); ++i)
+      for (int a = 0; a < 3; ++a) {
+        std::vector<Vec3> xp = x, xm = x;
+        const double h = 1e-8;
+        xp[i][a] += h;
+        xm[i][a] -= h;
+        const double grad = (field->elastic_energy(fm, xp) - field->elastic_energy(fm, xm)) / (2 * h);
+        worst = std::max(worst, std::abs(f[i][a] + grad));
+      }
+    EXPECT_LT(worst, 1e-5 * max_norm(f));
+  }
+}
+
+TEST(FemField, StiffnessProductIsTheJacobianOfTheForces) {
+  // Compared: K p at a random state against −(f(x + hp) − f(x − hp))/2h for a random p, h = 1e-7 m
+  // (|p| ≤ 1). Tolerance 1e-6 of |K p|: the difference's O(h²) error and rounding. Also the diagonal
+  // blocks the preconditioner uses: pᵀ K_nn p > 0 at every free node of a tetrahedral FEM.
+  std::mt19937 rng(kSeed + 5);
+  const Mesh m = block_mesh(4, 2);
+  const std::vector<Vec3> x = perturbed(m, rng, 0.5e-3);
+  std::vector<Vec3> dir(m.node_count());
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (auto& d : dir) d = Vec3(u(rng), u(rng), u(rng));
+  for (const FieldCase& c : kFields) {
+    SCOPED_TRACE(c.name);
+    const ForceModel fm = elastic_only(c);
+    auto field = make_force_field(m, fm);
+    field->linearize(fm, x);
+    std::vector<Vec3> kp, fp, fmn;
+    field->stiffness_product(dir, kp);
+    const double h = 1e-7;
+    std::vector<Vec3> xp = x, xm = x;
+    for (int64_t n = 0; n < m.node_count(); ++n) { xp[n] += h * dir[n]; xm[n] -= h * dir[n]; }
+    field->evaluate(fm, xp, {}, fp);
+    field->evaluate(fm, xm, {}, fmn);
+    double worst = 0.0;
+    for (int64_t n = 0; n < m.node_count(); ++n) worst = std::max(worst, (kp[n] + (fp[n] - fmn[n]) / (2 * h)).norm());
+    EXPECT_LT(worst, 1e-6 * max_norm(kp));
+    std::vector<Mat3> blocks;
+    field->linearize(fm, m.rest_m);
+    field->stiffness_diagonal(blocks);
+    for (int64_t n = 0; n < m.node_count(); ++n) EXPECT_GT(dir[n].dot(blocks[n] * dir[n]), 0.0) << n;
+  }
+}
+
+TEST(FemField, RigidMotionOfTheMeshGivesNoForce) {
+  // Compared: every node's force after a rotation by 2.5 rad and a 1 m translation of the whole mesh,
+  // against zero. Tolerance 1e-9 of the forces of a 1 % stretch: rounding (both laws are frame-indifferent).
+  const Mesh m = block_mesh(4, 2);
+  const Mat3 Q = rotation(Vec3(0.2, -1, 0.6), 2.5);
+  std::vector<Vec3> x(m.node_count()), stretched(m.node_count());
+  for (int64_t n = 0; n < m.node_count(); ++n) {
+    x[n] = Q * m.rest_m[n] + Vec3(1.0, -0.5, 0.25);
+    stretched[n] = 1.01 * m.rest_m[n];
+  }
+  for (const FieldCase& c : kFields) {
+    if (c.model == MaterialModel::Msd) continue;
+    SCOPED_TRACE(c.name);
+    const ForceModel fm = elastic_only(c);
+    auto field = make_force_field(m, fm);
+    std::vector<Vec3> f, fs;
+    field->evaluate(fm, stretched, {}, fs);
+    field->evaluate(fm, x, {}, f);
+    EXPECT_LT(max_norm(f), 1e-9 * max_norm(fs));
+  }
+}
+
+TEST(FemField, PatchTestReproducesAUniformStrainExactly) {
+  // The patch test: the boundary nodes of a solid block held at x = A x₀ (a uniform strain of up to 5 %
+  // with a rotation), the interior nodes started off it at random; Newton must put every interior node
+  // on A x₀. Compared: interior positions against A x₀. Tolerance 1e-9 m (of 5 mm cubes), where the
+  // solver's residual tolerance 1e-10 leaves sub-nanometre errors; a scheme that fails the patch test
+  // is off by micrometres or more.
+  std::mt19937 rng(kSeed + 6);
+  Mesh m = block_mesh(4, 1, /*shell=*/false);
+  const Mat3 A = rotation(Vec3(1, 1, 0), 0.3) * (Mat3::Identity() + random_matrix(rng, 0.05));
+  Vec3 lo = Vec3::Constant(1e9), hi = Vec3::Constant(-1e9);
+  for (const Vec3& p : m.rest_m) { lo = lo.cwiseMin(p); hi = hi.cwiseMax(p); }
+  std::vector<Vec3> start(m.node_count());
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int interior = 0;
+  for (int64_t n = 0; n < m.node_count(); ++n) {
+    const Vec3& p = m.rest_m[n];
+    const bool boundary = ((p - lo).cwiseAbs().minCoeff() < 1e-9) || ((hi - p).cwiseAbs().minCoeff() < 1e-9);
+    m.hold[n] = boundary ? kHoldAll : 0;
+    start[n] = A * p + (boundary ? Vec3::Zero() : Vec3(0.3e-3 * Vec3(u(rng), u(rng), u(rng))));
+    interior += !boundary;
+  }
+  ASSERT_GT(interior, 20);
+  Progress::set_enabled(false);
+  for (const FieldCase& c : kFields) {
+    if (c.model == MaterialModel::Msd) continue;
+    SCOPED_TRACE(c.name);
+    SolveOptions o;
+    o.method = SolverMethod::Newton;
+    o.forces = elastic_only(c);
+    o.residual_tolerance = 1e-10;
+    o.progress = false;
+    const SolveResult r = solve(m, o, start);
+    EXPECT_TRUE(r.converged) << r.stop_reason;
+    double worst = 0.0;
+    for (int64_t n = 0; n < m.node_count(); ++n) worst = std::max(worst, (r.x[n] - A * m.rest_m[n]).norm());
+    EXPECT_LT(worst, 1e-9);
+  }
+}
+
+TEST(FemLame, HollowSphereMatchesLamesClosedFormAndConverges) {
+  // Compared: the surface-mean radial displacement of Lamé's sphere (a = 50, b = 100 mm, E = 60 kPa,
+  // ν = 0.45, nearly incompressible) against the closed form with the nominal moduli, at 10 and 5 mm
+  // cubes, one placement, for both FEM laws with the cube-averaged dilatation. Tolerance 5 % at 5 mm
+  // (measured over four placements: co-rotational +0.6 / +3.0 %, neo-Hookean +0.8 / +3.5 % inner /
+  // outer; the staircase of the voxelised outer surface dominates), and the outer error must fall
+  // from 10 to 5 mm (measured 3.8 → 3.0 → 1.8 % at 10, 5, 2.5 mm for the co-rotational law).
+  Progress::set_enabled(false);
+  for (MaterialModel model : {MaterialModel::FemCorotational, MaterialModel::FemNeoHookean}) {
+    SCOPED_TRACE(enum_name(model));
+    double previous_outer = INFINITY;
+    for (double cube : {10.0, 5.0}) {
+      LameOptions o;
+      o.model = model;
+      o.poisson = 0.45;
+      o.cube_mm = cube;
+      o.placements = 1;
+      const LameResult r = validate_lame_sphere(o);
+      std::printf("%s cube %.0f mm: inner %+.2f %%, outer %+.2f %%\n", enum_name(model), cube, 100 * r.rel_error_inner,
+                  100 * r.rel_error_outer);
+      if (cube == 5.0) {
+        EXPECT_LE(std::abs(r.rel_error_inner), 0.05);
+        EXPECT_LE(std::abs(r.rel_error_outer), 0.05);
+        EXPECT_LT(std::abs(r.rel_error_outer), previous_outer);
+      }
+      previous_outer = std::abs(r.rel_error_outer);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pneumo
