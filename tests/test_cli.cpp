@@ -54,7 +54,7 @@ TEST(Cli, BadFilesGiveOneLineNamingTheFileAndExitTwo) {
 }
 
 TEST(Cli, InfoJsonHasTheDocumentedKeys) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   auto r = run_pneumo("info --json " + pneumo::testing_support::totalseg_dir() + "/example_ct.nii.gz");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -68,7 +68,7 @@ TEST(Cli, InfoJsonHasTheDocumentedKeys) {
 }
 
 TEST(Cli, InfoListsLabelIdsAndCounts) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   auto r = run_pneumo("info --json " + pneumo::testing_support::totalseg_dir() + "/example_seg_fast_force_split.nii.gz");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);

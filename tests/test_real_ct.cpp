@@ -1,4 +1,4 @@
-// The real CT in ../shared/data/totalseg-example-ct reads with the shape, spacing, orientation and
+// The real CT in data/totalseg-example-ct reads with the shape, spacing, orientation and
 // value range its README states (README.md there, section "example_ct.nii.gz").
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@ using namespace pneumo;
 using testing_support::totalseg_dir;
 
 TEST(RealCT, ReadsWithTheStatedGeometryAndValues) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   const Volume ct = read_volume(totalseg_dir() + "/example_ct.nii.gz");
   const Geometry& g = ct.geometry();
   EXPECT_EQ(g.dims, (Index3{122, 101, 112}));
@@ -33,7 +33,7 @@ TEST(RealCT, ReadsWithTheStatedGeometryAndValues) {
 }
 
 TEST(RealCT, LabelMapSharesTheGridAndHoldsExactlyTheLabelsOfLabelsCsv) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   const Volume ct = read_volume(totalseg_dir() + "/example_ct.nii.gz");
   const Volume labels = read_volume(totalseg_dir() + "/example_seg_fast_force_split.nii.gz");
   EXPECT_EQ(labels.type(), VoxelType::UInt8);
@@ -61,7 +61,7 @@ TEST(RealCT, LabelMapSharesTheGridAndHoldsExactlyTheLabelsOfLabelsCsv) {
 }
 
 TEST(RealCT, TheSmallSlabIsTheTopOfTheVolume) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   const Volume ct = read_volume(totalseg_dir() + "/example_ct.nii.gz");
   const Volume slab = read_volume(totalseg_dir() + "/example_ct_sm.nii.gz");
   EXPECT_EQ(slab.type(), VoxelType::Int16);

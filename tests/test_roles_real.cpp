@@ -1,7 +1,7 @@
-// Roles of the real CT (../shared/data/totalseg-example-ct, scenes/totalseg_example.json: automatic
+// Roles of the real CT (data/totalseg-example-ct, scenes/totalseg_example.json: automatic
 // rules plus TotalSegmentator's organ and bone labels, 60 mm of air added in front and at the sides).
 // The expectations are anatomical: volumes in adult ranges, organs viscera, spine fixed, the front
-// of the abdomen wall, the table left out. Skipped with a message without ../shared.
+// of the abdomen wall, the table left out.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -37,7 +37,7 @@ const RoleVolume& real_roles(double* seconds = nullptr) {
 }  // namespace
 
 TEST(RolesRealCT, PaddedGridKeepsEveryVoxel) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   double seconds = 0;
   const RoleVolume& rv = real_roles(&seconds);
   // 122 x 101 x 112 at 3 mm, RAS; 60 mm = 20 voxels on both i ends and the high (anterior) j end.
@@ -56,7 +56,7 @@ TEST(RolesRealCT, PaddedGridKeepsEveryVoxel) {
 }
 
 TEST(RolesRealCT, RoleVolumesAreThoseOfAnAdultAbdomen) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   const RoleVolume& rv = real_roles();
   const double wall_l = rv.volume_ml(Role::Wall) / 1000, viscera_l = rv.volume_ml(Role::Viscera) / 1000,
                fixed_l = rv.volume_ml(Role::Fixed) / 1000;
@@ -81,7 +81,7 @@ TEST(RolesRealCT, RoleVolumesAreThoseOfAnAdultAbdomen) {
 }
 
 TEST(RolesRealCT, OrgansAreVisceraAndTheSpineIsFixed) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   const RoleVolume& rv = real_roles();
   int64_t liver = 0, vertebrae = 0;
   for (std::size_t n = 0; n < rv.role.size(); ++n) {
@@ -100,7 +100,7 @@ TEST(RolesRealCT, OrgansAreVisceraAndTheSpineIsFixed) {
 }
 
 TEST(RolesRealCT, TheFrontOfTheAbdomenAtTheMidlineIsWall) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   const RoleVolume& rv = real_roles();
   const Geometry& g = rv.geometry;
   int64_t slices = 0, wall_first = 0;
@@ -128,7 +128,7 @@ TEST(RolesRealCT, TheFrontOfTheAbdomenAtTheMidlineIsWall) {
 }
 
 TEST(RolesRealCT, TheTableIsLeftOut) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   const RoleVolume& rv = real_roles();
   const Geometry& g = rv.geometry;
   // The table lies at the posterior edge (README: j = 0..9; its sides curve up beside the patient,
@@ -154,7 +154,7 @@ TEST(RolesRealCT, TheTableIsLeftOut) {
 // volume's origin (its world z is 246 mm off), so it is matched by index: slab (i, j, k) is padded
 // (i + 20, j, k + 82). The CT values are compared first to make sure of that.
 TEST(RolesRealCT, WallMatchesTheTissueMasksOfTheUpperAbdomen) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   const RoleVolume& rv = real_roles();
   const std::string d = totalseg_dir();
   const Volume slab = read_volume(d + "/example_ct_sm.nii.gz");

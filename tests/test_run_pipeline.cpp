@@ -178,7 +178,7 @@ TEST(RunPipeline, RealCtEndToEnd) {
   // the phantom: outputs on the working grid (the input's spacing and direction, grown by the scene's
   // padding, holding the input's grid), the wall rises (> 5 mm), a cavity opens (> 20 ml of warped
   // gas; the CT's field of view is tight), nothing inverts, the exterior views are not blank.
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   Progress::set_enabled(false);
   Scene scene = load_scene(std::string(PNEUMO_SOURCE_DIR) + "/scenes/totalseg_example.json");
   scene.render.width = 128;

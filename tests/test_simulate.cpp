@@ -130,7 +130,7 @@ TEST(Simulate, NoWallVisceraInterfaceIsAClearError) {
 }
 
 TEST(Simulate, RealCtSceneInflates) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   Progress::set_enabled(false);
   Scene scene = load_scene(std::string(PNEUMO_SOURCE_DIR) + "/scenes/totalseg_example.json");
   const Simulation sim = simulate_scene(scene);
@@ -173,7 +173,7 @@ TEST(Simulate, OpenClReachesTheCpuEquilibriumOnThePhantom) {
 }
 
 TEST(Simulate, OpenClReachesTheCpuEquilibriumOnTheRealCt) {
-  PNEUMO_REQUIRE_SHARED_DATA();
+  PNEUMO_REQUIRE_REAL_CT();
   Progress::set_enabled(false);
   expect_same_equilibrium_on_opencl(load_scene(std::string(PNEUMO_SOURCE_DIR) + "/scenes/totalseg_example.json"));
 }

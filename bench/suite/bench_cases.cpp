@@ -67,8 +67,7 @@ std::optional<BenchCase> scene_case(const std::string& scene_path, const std::st
   c.name = name;
   c.scene = load_scene(scene_path);
   if (c.scene.inputs.ct.empty() || !fs::exists(c.scene.inputs.ct)) {
-    why = "the CT of " + scene_path + " (" + c.scene.inputs.ct + ") is not there (the project's shared data folder "
-          "beside the repository)";
+    why = "the CT of " + scene_path + " (" + c.scene.inputs.ct + ") is not there (the repository's data/ folder)";
     return std::nullopt;
   }
   const auto t0 = Clock::now();
