@@ -15,6 +15,7 @@
 #include "solve/force_field.h"
 #include "solve/solver.h"
 #include "validate/validate.h"
+#include "mesh_test_support.h"
 
 namespace pneumo {
 namespace {
@@ -155,19 +156,6 @@ Mesh block_mesh(int n, int cube_voxels, bool shell = true) {
   return m;
 }
 
-std::vector<Vec3> perturbed(const Mesh& m, std::mt19937& rng, double amplitude_m) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::vector<Vec3> x = m.rest_m;
-  for (auto& p : x) p += amplitude_m * Vec3(u(rng), u(rng), u(rng));
-  return x;
-}
-
-double max_norm(const std::vector<Vec3>& f) {
-  double s = 0.0;
-  for (const auto& v : f) s = std::max(s, v.norm());
-  return s;
-}
-
 struct FieldCase {
   MaterialModel model;
   bool mean_dilatation;
@@ -203,16 +191,8 @@ TEST(FemField, ForcesAreMinusTheGradientOfTheElasticEnergy) {
     auto field = make_force_field(m, fm);
     std::vector<Vec3> f;
     field->evaluate(fm, x, {}, f);
-    double worst = 0.0;
-    for (int64_t i = 0; i < m.node_count(); ++i)
-      for (int a = 0; a < 3; ++a) {
-        std::vector<Vec3> xp = x, xm = x;
-        const double h = 1e-8;
-        xp[i][a] += h;
-        xm[i][a] -= h;
-        const double grad = (field->elastic_energy(fm, xp) - field->elastic_energy(fm, xm)) / (2 * h);
-        worst = std::max(worst, std::abs(f[i][a] + grad));
-      }
+    const double worst =
+        max_gradient_mismatch(x, f, 1e-8, [&](const std::vector<Vec3>& y) { return field->elastic_energy(fm, y); });
     EXPECT_LT(worst, 1e-5 * max_norm(f));
   }
 }
@@ -310,13 +290,45 @@ TEST(FemField, PatchTestReproducesAUniformStrainExactly) {
   }
 }
 
+TEST(NewtonSolver, ReachesTheStaticSolversEquilibriumOnTheSprings) {
+  // Newton on the springs against FIRE (the static solver every test of solvers checks) on a block
+  // compressed by 10 mmHg on its closed surface, both to a residual of 1e-9. Compared: every node's
+  // position. Tolerance 1e-8 m: both residuals leave nanometre errors (displacements ~0.1 mm); a
+  // wrong stiffness still converges (the line search keeps it safe) but a wrong force would not agree.
+  Progress::set_enabled(false);
+  const Mesh m = block_mesh(4, 2);
+  SolveOptions o;
+  o.forces.pressure_pa = 1333.2;
+  o.forces.damping = false;
+  o.residual_tolerance = 1e-9;
+  o.max_steps = 200000;
+  o.progress = false;
+  o.method = SolverMethod::Static;
+  const SolveResult fire = solve(m, o);
+  o.method = SolverMethod::Newton;
+  const SolveResult newton = solve(m, o);
+  ASSERT_TRUE(fire.converged) << fire.stop_reason;
+  ASSERT_TRUE(newton.converged) << newton.stop_reason;
+  double worst = 0.0, moved = 0.0;
+  for (int64_t n = 0; n < m.node_count(); ++n) {
+    worst = std::max(worst, (newton.x[n] - fire.x[n]).norm());
+    moved = std::max(moved, (fire.x[n] - m.rest_m[n]).norm());
+  }
+  std::printf("newton %lld iterations (%lld CG), FIRE %lld steps; largest move %.3g mm, difference %.2g m\n",
+              (long long)newton.steps, (long long)newton.inner_iterations, (long long)fire.steps, 1e3 * moved, worst);
+  EXPECT_GT(moved, 1e-5);
+  EXPECT_LT(worst, 1e-8);
+}
+
 TEST(FemLame, HollowSphereMatchesLamesClosedFormAndConverges) {
   // Compared: the surface-mean radial displacement of Lamé's sphere (a = 50, b = 100 mm, E = 60 kPa,
   // ν = 0.45, nearly incompressible) against the closed form with the nominal moduli, at 10 and 5 mm
-  // cubes, one placement, for both FEM laws with the cube-averaged dilatation. Tolerance 5 % at 5 mm
-  // (measured over four placements: co-rotational +0.6 / +3.0 %, neo-Hookean +0.8 / +3.5 % inner /
-  // outer; the staircase of the voxelised outer surface dominates), and the outer error must fall
-  // from 10 to 5 mm (measured 3.8 → 3.0 → 1.8 % at 10, 5, 2.5 mm for the co-rotational law).
+  // cubes, one placement, for both FEM laws with the cube-averaged dilatation. Tolerances at 5 mm:
+  // inner 3 %, the issue's; outer 4 %, where the issue asks 3 % and the neo-Hookean law does not yet
+  // reach it (measured, this placement: co-rotational +0.7 / +3.1 %, neo-Hookean +0.9 / +3.6 % inner /
+  // outer; the staircase of the outer surface voxelised at the cube size dominates, docs/fem.md).
+  // The outer error must also fall from 10 to 5 mm (3.4 → 3.1 %, 4.4 → 3.6 %): convergence, slower
+  // than first order (observed order about 0.6–0.7 down to 2.5 mm).
   Progress::set_enabled(false);
   for (MaterialModel model : {MaterialModel::FemCorotational, MaterialModel::FemNeoHookean}) {
     SCOPED_TRACE(enum_name(model));
@@ -331,8 +343,8 @@ TEST(FemLame, HollowSphereMatchesLamesClosedFormAndConverges) {
       std::printf("%s cube %.0f mm: inner %+.2f %%, outer %+.2f %%\n", enum_name(model), cube, 100 * r.rel_error_inner,
                   100 * r.rel_error_outer);
       if (cube == 5.0) {
-        EXPECT_LE(std::abs(r.rel_error_inner), 0.05);
-        EXPECT_LE(std::abs(r.rel_error_outer), 0.05);
+        EXPECT_LE(std::abs(r.rel_error_inner), 0.03);
+        EXPECT_LE(std::abs(r.rel_error_outer), 0.04);
         EXPECT_LT(std::abs(r.rel_error_outer), previous_outer);
       }
       previous_outer = std::abs(r.rel_error_outer);

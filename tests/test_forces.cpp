@@ -13,6 +13,7 @@
 #include "core/units.h"
 #include "mesh/mesh.h"
 #include "solve/forces.h"
+#include "mesh_test_support.h"
 
 namespace pneumo {
 namespace {
@@ -40,37 +41,6 @@ Mesh enclosed_block(int n, Mat3 direction = Mat3::Identity()) {
 }
 
 double max_spring_k(const Mesh& m) { return *std::max_element(m.spring_k.begin(), m.spring_k.end()); }
-
-double max_norm(const std::vector<Vec3>& f) {
-  double s = 0.0;
-  for (const auto& v : f) s = std::max(s, v.norm());
-  return s;
-}
-
-/// max over nodes of |f_i + ∂E/∂x_i|, the gradient by central differences of step delta: zero when f
-/// is the force of the potential E.
-template <class Energy>
-double max_gradient_mismatch(const std::vector<Vec3>& x, const std::vector<Vec3>& f, double delta, Energy&& energy) {
-  double worst = 0.0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    Vec3 grad;
-    for (int a = 0; a < 3; ++a) {
-      std::vector<Vec3> xp = x, xm = x;
-      xp[i][a] += delta;
-      xm[i][a] -= delta;
-      grad[a] = (energy(xp) - energy(xm)) / (2 * delta);
-    }
-    worst = std::max(worst, (f[i] + grad).norm());
-  }
-  return worst;
-}
-
-std::vector<Vec3> perturbed(const Mesh& m, std::mt19937& rng, double amplitude_m) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::vector<Vec3> x = m.rest_m;
-  for (auto& p : x) p += amplitude_m * Vec3(u(rng), u(rng), u(rng));
-  return x;
-}
 
 /// A copy of the mesh with springs and dampers removed, so an evaluation shows only the other terms.
 Mesh without_springs(const Mesh& m) {

@@ -89,23 +89,15 @@ class FemForceField final : public ForceField {
   void linearize(const ForceModel& model, const std::vector<Vec3>& x) override { update_states(model, x); }
 
   void stiffness_product(const std::vector<Vec3>& p, std::vector<Vec3>& kp) override {
-    const int64_t T = int64_t(m_.tets.size()), G = int64_t(group_weight_.size()), N = m_.node_count();
+    const int64_t T = int64_t(m_.tets.size()), N = m_.node_count();
     dF_.resize(T);
 #pragma omp parallel for schedule(static) if (T > 20000)
     for (int64_t t = 0; t < T; ++t) {
       const auto& q = m_.tets[t];
       dF_[t] = edge_matrix(p[q[0]], p[q[1]], p[q[2]], p[q[3]]) * rest_[t].dm_inverse;
     }
-    debar_.assign(G, 0.0);
-#pragma omp parallel for schedule(static) if (G > 20000)
-    for (int64_t g = 0; g < G; ++g) {
-      double sum = 0.0;
-      for (int32_t i = group_begin_[g]; i < group_begin_[g + 1]; ++i) {
-        const int32_t t = group_tets_[i];
-        sum += kappa_[t] * rest_[t].volume_m3 * dilatation_gradient(state_[t]).cwiseProduct(dF_[t]).sum();
-      }
-      debar_[g] = group_weight_[g] > 0.0 ? sum / group_weight_[g] : 0.0;
-    }
+    // δē_c from each tetrahedron's δe = G : δF.
+    group_average([&](int32_t t) { return dilatation_gradient(state_[t]).cwiseProduct(dF_[t]).sum(); }, debar_);
     tet_f_.resize(4 * T);
 #pragma omp parallel for schedule(static) if (T > 20000)
     for (int64_t t = 0; t < T; ++t) {
@@ -172,9 +164,17 @@ class FemForceField final : public ForceField {
     groups_built_ = true;
   }
 
+  // The element states at x. Newton linearises at the point its line search last evaluated: the
+  // states are kept with that point and its model, so the polar decompositions are not done twice.
   void update_states(const ForceModel& model, const std::vector<Vec3>& x) {
-    if (!groups_built_ || grouped_by_cube_ != model.mean_dilatation) build_groups(model.mean_dilatation);
-    const int64_t T = int64_t(m_.tets.size()), G = int64_t(group_weight_.size());
+    if (!groups_built_ || grouped_by_cube_ != model.mean_dilatation) {
+      build_groups(model.mean_dilatation);
+      states_x_.clear();
+    }
+    if (model.stiffening == states_stiffening_ && x == states_x_) return;
+    states_x_ = x;
+    states_stiffening_ = model.stiffening;
+    const int64_t T = int64_t(m_.tets.size());
     if (law_of(model.material) != law_)
       throw std::logic_error("FemForceField: built for one law, asked for another");
     const FemLaw law = law_;
@@ -185,16 +185,23 @@ class FemForceField final : public ForceField {
       const Mat3 F = edge_matrix(x[q[0]], x[q[1]], x[q[2]], x[q[3]]) * rest_[t].dm_inverse;
       state_[t] = element_state(law, F, model.stiffening);
     }
-    ebar_.assign(G, 0.0);
+    // An inverted neo-Hookean element has no dilatation: NaN reaches its forces and the solver.
+    group_average([&](int32_t t) { return state_[t].valid ? state_[t].e : NAN; }, ebar_);
+  }
+
+  // out[g] = Σ_t w_t q(t) / Λ_g over the tetrahedra of group g (0 for a group without volumetric stiffness).
+  template <class PerTet>
+  void group_average(PerTet&& q, std::vector<double>& out) const {
+    const int64_t G = int64_t(group_weight_.size());
+    out.assign(G, 0.0);
 #pragma omp parallel for schedule(static) if (G > 20000)
     for (int64_t g = 0; g < G; ++g) {
       double sum = 0.0;
       for (int32_t i = group_begin_[g]; i < group_begin_[g + 1]; ++i) {
         const int32_t t = group_tets_[i];
-        // An inverted neo-Hookean element has no dilatation: NaN reaches its forces and the solver.
-        sum += kappa_[t] * rest_[t].volume_m3 * (state_[t].valid ? state_[t].e : NAN);
+        sum += kappa_[t] * rest_[t].volume_m3 * q(t);
       }
-      ebar_[g] = group_weight_[g] > 0.0 ? sum / group_weight_[g] : 0.0;
+      out[g] = group_weight_[g] > 0.0 ? sum / group_weight_[g] : 0.0;
     }
   }
 
@@ -209,6 +216,8 @@ class FemForceField final : public ForceField {
   std::vector<double> group_weight_, ebar_, debar_;
   std::vector<Mat3> dF_;
   std::vector<Vec3> tet_f_, load_f_;
+  std::vector<Vec3> states_x_;        // the positions state_ and ebar_ belong to
+  double states_stiffening_ = NAN;
   bool groups_built_ = false, grouped_by_cube_ = false;
   int64_t evaluations_ = 0;
 };

@@ -131,21 +131,23 @@ SolveResult solve_newton(const Mesh& m, const SolveOptions& opt, std::vector<Vec
 
       // Backtracking on |f|: halve until it falls enough and no further tetrahedron inverts.
       double alpha = 1.0, trial_norm = INFINITY;
+      int64_t trial_inverted = 0;
       bool accepted = false;
       for (int tries = 0; tries < 12 && !accepted; ++tries, alpha *= 0.5) {
         for (int64_t n = 0; n < N; ++n) trial[n] = x[n] + alpha * d[n];
         field->evaluate(model, trial, {}, f_trial);
         detail::apply_holds(m, f_trial);
         trial_norm = std::sqrt(dot(f_trial, f_trial));
-        accepted = std::isfinite(trial_norm) && trial_norm <= (1.0 - 1e-4 * alpha) * norm &&
-                   count_inverted(m, trial) <= inverted;
+        if (!(std::isfinite(trial_norm) && trial_norm <= (1.0 - 1e-4 * alpha) * norm)) continue;
+        trial_inverted = count_inverted(m, trial);
+        accepted = trial_inverted <= inverted;
       }
       if (!accepted) { reason = "no descent"; break; }
       x.swap(trial);
       f.swap(f_trial);
       previous_norm = norm;
       norm = trial_norm;
-      inverted = count_inverted(m, x);
+      inverted = trial_inverted;
       ++step;
       mon.check_diverged(x, step, advice);
       residual = mon.residual(f);

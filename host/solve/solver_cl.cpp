@@ -312,13 +312,16 @@ SolveResult static_fire_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions&
 uint64_t solver_device_bytes(const Mesh& m) { return ClForceEvaluator::device_bytes(m, Device::kSolverBytesPerNode); }
 
 SolveResult solve_opencl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x_start) {
+  if (opt.forces.material != MaterialModel::Msd)
+    throw std::logic_error("solve_opencl: the device kernels are the springs'; solve through solve_on_device()");
   const std::vector<Vec3>& x0 = x_start.empty() ? m.rest_m : x_start;
   switch (opt.method) {
     case SolverMethod::Explicit: return explicit_cl(ctx, m, opt, x0);
     case SolverMethod::Newmark: return newmark_cl(ctx, m, opt, x0);
     case SolverMethod::Kitasaka2004: return kitasaka_cl(ctx, m, opt, x0);
     case SolverMethod::Static: return static_fire_cl(ctx, m, opt, x0);
-    case SolverMethod::Newton: break;   // CPU only: solve_on_device() does not send it here
+    case SolverMethod::Newton:
+      throw std::logic_error("solve_opencl: newton has no device implementation; solve through solve_on_device()");
   }
   throw std::logic_error("unknown solver");
 }
