@@ -444,6 +444,21 @@ TEST(SceneRules, PortTargetsAndPathKeyframes) {
   EXPECT_CONTAINS(error_of(j), "material.label_young_kpa[1].label = 3 is listed twice (also material.label_young_kpa[0])");
 }
 
+TEST(SceneRules, FiniteElementsNeedNewtonAndRefuseTheSpringsOwnKeys) {
+  // Each rule of check_material_model, with the message a user reads.
+  const json fem = {{"material", {{"model", "fem-corotational"}}}};
+  EXPECT_CONTAINS(error_of(fem), "solver.method = \"static\" cannot solve material.model \"fem-corotational\"; use \"newton\"");
+  json j = {{"material", {{"model", "fem-corotational"}, {"stiffening", 5}}}, {"solver", {{"method", "newton"}}}};
+  EXPECT_CONTAINS(error_of(j), "material.stiffening = 5");
+  j = {{"material", {{"model", "fem-neohookean"}, {"volume_stiffness_kpa", 60}}}, {"solver", {{"method", "newton"}}}};
+  EXPECT_CONTAINS(error_of(j), "material.volume_stiffness_kpa = 60");
+  j = {{"material", {{"model", "fem-neohookean"}, {"stiffening", 5}, {"wall_poisson_ratio", 0.49}}},
+       {"solver", {{"method", "newton"}}}};
+  const Scene s = parse_scene(j, kOrigin);
+  EXPECT_DOUBLE_EQ(s.poisson_for(Role::Wall, 0), 0.49);
+  EXPECT_DOUBLE_EQ(s.poisson_for(Role::Viscera, 0), 0.45);
+}
+
 TEST(SceneRules, Queries) {
   Scene s = parse_scene({{"roles", {{"wall_labels", json::array({2})}, {"viscera_labels", {5, 6}}, {"fixed_labels", json::array({9})},
                                     {"unlisted_label_role", "viscera"}}},

@@ -67,6 +67,10 @@ void check_material_model(const Scene& s, const At& root) {
     root.child("material").child("stiffening").fail_value(m.stiffening,
                                                           "has no meaning for \"fem-corotational\" (a linear law); "
                                                           "use \"fem-neohookean\" for Demiray's stiffening, or 0");
+  if (m.volume_stiffness_kpa)
+    root.child("material").child("volume_stiffness_kpa").fail_value(*m.volume_stiffness_kpa,
+                                                                    "is the springs' volume term; the finite elements "
+                                                                    "take material.poisson_ratio instead: remove it");
   if (m.spring_model != SpringModel::Nonlinear)
     root.child("material").child("spring_model").fail_value(enum_name(m.spring_model),
                                                             "applies to the springs only; remove it with a FEM model");
