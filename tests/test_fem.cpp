@@ -13,6 +13,7 @@
 #include "mesh/mesh.h"
 #include "solve/fem_element.h"
 #include "solve/force_field.h"
+#include "solve/pressure_stiffness.h"
 #include "solve/solver.h"
 #include "validate/validate.h"
 #include "mesh_test_support.h"
@@ -227,6 +228,43 @@ TEST(FemField, StiffnessProductIsTheJacobianOfTheForces) {
     field->stiffness_diagonal(blocks);
     for (int64_t n = 0; n < m.node_count(); ++n) EXPECT_GT(dir[n].dot(blocks[n] * dir[n]), 0.0) << n;
   }
+}
+
+TEST(PressureStiffness, IsTheJacobianOfTheGasPressureOnAClosedSurface) {
+  // The wall block inside its viscera shell: the cavity faces around it are closed on each side, so
+  // the load is exactly P ∇V and its stiffness symmetric, and the per-load symmetric parts must sum to
+  // the whole Jacobian. Compared: S p against −(f_p(x + hp) − f_p(x − hp))/2h at a random state,
+  // h = 1e-7 m. Tolerance 1e-6 of |S p|: the difference's error and rounding. Then the symmetry,
+  // qᵀ S p = pᵀ S q, to rounding (1e-12 relative).
+  std::mt19937 rng(kSeed + 7);
+  const Mesh m = block_mesh(4, 2);
+  ASSERT_FALSE(m.load_tet.empty());
+  const std::vector<Vec3> x = perturbed(m, rng, 0.5e-3);
+  std::vector<Vec3> p(m.node_count()), q(m.node_count());
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (auto& d : p) d = Vec3(u(rng), u(rng), u(rng));
+  for (auto& d : q) d = Vec3(u(rng), u(rng), u(rng));
+  const double P = 1600.0;
+  PressureStiffness ks;
+  ks.linearize(m, x, P);
+  std::vector<Vec3> sp(m.node_count(), Vec3::Zero()), sq(m.node_count(), Vec3::Zero());
+  ks.add_product(p, sp);
+  ks.add_product(q, sq);
+  const double h = 1e-7;
+  std::vector<Vec3> xp = x, xm = x;
+  for (int64_t n = 0; n < m.node_count(); ++n) { xp[n] += h * p[n]; xm[n] -= h * p[n]; }
+  const std::vector<Vec3> fp = pressure_forces(m, xp, P), fmn = pressure_forces(m, xm, P);
+  double worst = 0.0;
+  for (int64_t n = 0; n < m.node_count(); ++n) worst = std::max(worst, (sp[n] + (fp[n] - fmn[n]) / (2 * h)).norm());
+  EXPECT_GT(max_norm(sp), 0.0);
+  EXPECT_LT(worst, 1e-6 * max_norm(sp));
+  double qsp = 0.0, psq = 0.0, scale = 0.0;
+  for (int64_t n = 0; n < m.node_count(); ++n) {
+    qsp += q[n].dot(sp[n]);
+    psq += p[n].dot(sq[n]);
+    scale += q[n].norm() * sp[n].norm();
+  }
+  EXPECT_LT(std::abs(qsp - psq), 1e-12 * scale);
 }
 
 TEST(FemField, RigidMotionOfTheMeshGivesNoForce) {

@@ -6,8 +6,9 @@
 //
 // Besides the forces, a model offers its linearisation for the Newton solver: the stiffness
 // K = −∂f_elastic/∂x at a state, as a matrix-free product and as the 3×3 blocks of its diagonal
-// (the preconditioner). The pressure's follower load and gravity are not in K (solve_newton.cpp
-// says why). Units: metres, newtons, joules.
+// (the preconditioner). The pressure's follower load is not in K: its stiffness is the same for
+// every model (pressure_stiffness.h); gravity, a constant force, has none. Units: metres, newtons,
+// joules.
 #include <cstdint>
 #include <memory>
 #include <vector>

@@ -1,23 +1,28 @@
 // Static equilibrium by Newton's method with matrix-free preconditioned conjugate gradients, on any
 // force field (force_field.h): the springs or the finite elements (issue "Bano's row").
 //
-// Each Newton iteration solves K d = f(x) for the step d, with K the elastic stiffness at x, by CG
-// preconditioned with the inverse 3×3 diagonal blocks of K (block Jacobi), to a relative residual η
-// chosen as Eisenstat & Walker (1996, choice 2: η = 0.9 (|f_k|/|f_{k−1}|)², within [10⁻³, 0.1]), so
-// early iterations are cheap and late ones converge fast. CG stops at a direction of non-positive
-// curvature (compressed springs, a buckling element) and keeps what it has, or the preconditioned
-// force on the first iteration. A backtracking line search halves the step until |f| falls
-// (sufficient decrease, 10⁻⁴) and no further tetrahedron inverts.
+// Each Newton iteration solves K d = f(x) for the step d, with K = −∂f/∂x the stiffness at x (the
+// force field's elastic part and the gas pressure's, pressure_stiffness.h), by CG preconditioned with
+// the inverse 3×3 diagonal blocks of K (block Jacobi), to a relative residual η chosen as Eisenstat &
+// Walker (1996, choice 2: η = 0.9 (|f_k|/|f_{k−1}|)², within [10⁻³, 0.1]), so early iterations are
+// cheap and late ones converge fast. A backtracking line search halves the step until |f| falls
+// (sufficient decrease, 10⁻⁴) and no further tetrahedron inverts. The load is applied in the static
+// solver's increments, each solved before the next.
 //
-// Why K leaves out the pressure: the gas pressure is a follower load whose derivative is not
-// symmetric, and CG needs a symmetric matrix. Leaving it out makes this a modified Newton method that
-// converges linearly at a rate near the ratio of the pressure's stiffness to the tissue's (P/E, small
-// at surgical pressures: 1.6 kPa against a wall of tens of kPa), with the line search keeping it
-// safe. The load is applied in the static solver's increments, each solved before the next.
+// Why the pressure's stiffness is in K: with soft fat (a few kPa) the wall's stiffness is of the order
+// of the gas pressure's (1.6 kPa at 12 mmHg); without it Newton degrades to a linearly converging
+// method (on the real CT with the Demiray law: 50 iterations against 17, docs/fem.md).
+//
+// Where K is indefinite (compressed springs, the co-rotational stress term under compression, the
+// pressure on a wall near its limit point) CG meets a direction of non-positive curvature; then
+// K + σ D is solved instead, D the diagonal blocks of K, σ growing tenfold from 10⁻³ until CG completes
+// (a Levenberg–Marquardt shift towards scaled steepest descent) and shrinking tenfold after each full
+// step.
 #include <algorithm>
 #include <cmath>
 
 #include "solve/force_field.h"
+#include "solve/pressure_stiffness.h"
 #include "solve/solver_common.h"
 
 namespace pneumo {
@@ -58,9 +63,12 @@ struct CgOutcome {
   bool negative_curvature = false;
 };
 
-// Solves K d = f to |f − K d| ≤ η |f| on the free axes.
-CgOutcome conjugate_gradients(const Mesh& m, ForceField& field, const std::vector<Mat3>& precond,
-                              const std::vector<Vec3>& f, double eta, int max_iterations, std::vector<Vec3>& d) {
+// Solves (K + σ D) d = f to |f − (K + σ D) d| ≤ η |f| on the free axes, D the diagonal blocks of K
+// (`blocks`, used only when σ > 0).
+CgOutcome conjugate_gradients(const Mesh& m, ForceField& field, const PressureStiffness& pressure,
+                              const std::vector<Mat3>& precond,
+                              const std::vector<Mat3>& blocks, double sigma, const std::vector<Vec3>& f,
+                              double eta, int max_iterations, std::vector<Vec3>& d) {
   const std::size_t N = f.size();
   CgOutcome out;
   std::vector<Vec3> r = f, z(N), p(N), kp;
@@ -71,11 +79,13 @@ CgOutcome conjugate_gradients(const Mesh& m, ForceField& field, const std::vecto
   const double stop = eta * std::sqrt(dot(f, f));
   for (int it = 0; it < max_iterations; ++it) {
     field.stiffness_product(p, kp);
+    pressure.add_product(p, kp);
+    if (sigma > 0.0)
+      for (std::size_t n = 0; n < N; ++n) kp[n] += sigma * (blocks[n] * p[n]);
     detail::apply_holds(m, kp);
     const double pkp = dot(p, kp);
     if (!(pkp > 0.0)) {
       out.negative_curvature = true;
-      if (it == 0) d = z;   // the preconditioned force: still a descent direction
       break;
     }
     const double a = rz / pkp;
@@ -105,6 +115,9 @@ SolveResult solve_newton(const Mesh& m, const SolveOptions& opt, std::vector<Vec
 
   std::vector<Vec3> f, trial(N), f_trial, d;
   std::vector<Mat3> blocks;
+  PressureStiffness pressure;
+  constexpr double kFirstShift = 1e-3, kMaxShift = 1e3;
+  double shift = 0.0;
   int64_t step = 0, cg_iterations = 0;
   double residual = INFINITY;
   bool converged = false;
@@ -121,28 +134,37 @@ SolveResult solve_newton(const Mesh& m, const SolveOptions& opt, std::vector<Vec
     bool increment_done = residual < tol;
     while (!increment_done && step < opt.max_steps) {
       field->linearize(model, x);
+      pressure.linearize(m, x, model.pressure_pa);
       field->stiffness_diagonal(blocks);
       const std::vector<Mat3> precond = block_jacobi(m, blocks);
       const double eta = std::isfinite(previous_norm)
                              ? std::clamp(0.9 * (norm / previous_norm) * (norm / previous_norm), 1e-3, 0.1)
                              : 0.1;
-      const CgOutcome cg = conjugate_gradients(m, *field, precond, f, eta, opt.newton_max_cg_iterations, d);
-      cg_iterations += cg.iterations;
+      // At negative curvature: the shifted system K + σ D (above).
+      CgOutcome cg;
+      for (;;) {
+        cg = conjugate_gradients(m, *field, pressure, precond, blocks, shift, f, eta, opt.newton_max_cg_iterations, d);
+        cg_iterations += cg.iterations;
+        if (!cg.negative_curvature) break;
+        shift = shift > 0.0 ? 10.0 * shift : kFirstShift;
+        if (shift > kMaxShift) break;
+      }
 
       // Backtracking on |f|: halve until it falls enough and no further tetrahedron inverts.
       double alpha = 1.0, trial_norm = INFINITY;
       int64_t trial_inverted = 0;
       bool accepted = false;
-      for (int tries = 0; tries < 12 && !accepted; ++tries, alpha *= 0.5) {
+      for (int tries = 0; tries < 12; ++tries, alpha *= 0.5) {
         for (int64_t n = 0; n < N; ++n) trial[n] = x[n] + alpha * d[n];
         field->evaluate(model, trial, {}, f_trial);
         detail::apply_holds(m, f_trial);
         trial_norm = std::sqrt(dot(f_trial, f_trial));
         if (!(std::isfinite(trial_norm) && trial_norm <= (1.0 - 1e-4 * alpha) * norm)) continue;
         trial_inverted = count_inverted(m, trial);
-        accepted = trial_inverted <= inverted;
+        if ((accepted = trial_inverted <= inverted)) break;
       }
       if (!accepted) { reason = "no descent"; break; }
+      if (alpha == 1.0) shift = shift > kFirstShift ? 0.1 * shift : 0.0;
       x.swap(trial);
       f.swap(f_trial);
       previous_norm = norm;
