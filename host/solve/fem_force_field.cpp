@@ -15,35 +15,20 @@
 // gathered as K p = V_t δP_t D_m⁻ᵀ per vertex (the nodal forces' derivative, sign flipped).
 #include <algorithm>
 #include <cmath>
-#include <numeric>
+#include <optional>
 #include <stdexcept>
 
 #include "solve/fem_element.h"
+#include "solve/fem_tets.h"
 #include "solve/force_field.h"
 
 namespace pneumo {
 
 namespace {
 
-FemLaw law_of(MaterialModel m) {
-  return m == MaterialModel::FemNeoHookean ? FemLaw::NeoHookean : FemLaw::Corotational;
-}
-
 class FemForceField final : public ForceField {
  public:
-  explicit FemForceField(const Mesh& m, FemLaw law) : m_(m), law_(law), adj_(Adjacency::of(m)) {
-    const int64_t T = int64_t(m.tets.size());
-    rest_.resize(T);
-    lame_.resize(T);
-    kappa_.resize(T);
-    for (int64_t t = 0; t < T; ++t) {
-      const auto& q = m.tets[t];
-      rest_[t] = tet_rest(m.rest_m[q[0]], m.rest_m[q[1]], m.rest_m[q[2]], m.rest_m[q[3]]);
-      const double nu = m.tet_poisson.empty() ? 0.25 : m.tet_poisson[t];
-      lame_[t] = Lame::from_young_poisson(m.tet_young_pa[t], nu);
-      kappa_[t] = volumetric_modulus(law, lame_[t]);
-    }
-  }
+  explicit FemForceField(const Mesh& m, FemLaw law) : m_(m), law_(law), adj_(Adjacency::of(m)), tets_(m, law) {}
 
   void evaluate(const ForceModel& model, const std::vector<Vec3>& x, const std::vector<Vec3>&,
                 std::vector<Vec3>& f) override {
@@ -55,8 +40,8 @@ class FemForceField final : public ForceField {
 #pragma omp parallel for schedule(static) if (T > 20000)
     for (int64_t t = 0; t < T; ++t) {
       const ElementState& s = state_[t];
-      const Mat3 P = deviatoric_piola(s, lame_[t]) + kappa_[t] * ebar_[group_of_tet_[t]] * dilatation_gradient(s);
-      const auto fe = nodal_forces(P, rest_[t]);
+      const Mat3 P = deviatoric_piola(s, tets_.lame[t]) + tets_.kappa[t] * ebar_[groups_->group_of_tet[t]] * dilatation_gradient(s);
+      const auto fe = nodal_forces(P, tets_.rest[t]);
       for (int i = 0; i < 4; ++i) tet_f_[4 * t + i] = fe[i];
     }
     load_f_.resize(model.pressure_pa != 0.0 ? 4 * R : 0);
@@ -81,8 +66,8 @@ class FemForceField final : public ForceField {
   double elastic_energy(const ForceModel& model, const std::vector<Vec3>& x) override {
     update_states(model, x);
     double e = 0.0;
-    for (std::size_t t = 0; t < m_.tets.size(); ++t) e += rest_[t].volume_m3 * deviatoric_energy_density(state_[t], lame_[t]);
-    for (std::size_t g = 0; g < ebar_.size(); ++g) e += 0.5 * group_weight_[g] * ebar_[g] * ebar_[g];
+    for (std::size_t t = 0; t < m_.tets.size(); ++t) e += tets_.rest[t].volume_m3 * deviatoric_energy_density(state_[t], tets_.lame[t]);
+    for (std::size_t g = 0; g < ebar_.size(); ++g) e += 0.5 * groups_->weight[g] * ebar_[g] * ebar_[g];
     return e;
   }
 
@@ -94,7 +79,7 @@ class FemForceField final : public ForceField {
 #pragma omp parallel for schedule(static) if (T > 20000)
     for (int64_t t = 0; t < T; ++t) {
       const auto& q = m_.tets[t];
-      dF_[t] = edge_matrix(p[q[0]], p[q[1]], p[q[2]], p[q[3]]) * rest_[t].dm_inverse;
+      dF_[t] = edge_matrix(p[q[0]], p[q[1]], p[q[2]], p[q[3]]) * tets_.rest[t].dm_inverse;
     }
     // δē_c from each tetrahedron's δe = G : δF.
     group_average([&](int32_t t) { return dilatation_gradient(state_[t]).cwiseProduct(dF_[t]).sum(); }, debar_);
@@ -102,10 +87,10 @@ class FemForceField final : public ForceField {
 #pragma omp parallel for schedule(static) if (T > 20000)
     for (int64_t t = 0; t < T; ++t) {
       const ElementState& s = state_[t];
-      const int32_t g = group_of_tet_[t];
-      const Mat3 dP = deviatoric_dpiola(s, dF_[t], lame_[t]) +
-                      kappa_[t] * (debar_[g] * dilatation_gradient(s) + ebar_[g] * dilatation_dgradient(s, dF_[t]));
-      const auto fe = nodal_forces(dP, rest_[t]);   // −V₀ δP D_m⁻ᵀ: the forces' change, −K p
+      const int32_t g = groups_->group_of_tet[t];
+      const Mat3 dP = deviatoric_dpiola(s, dF_[t], tets_.lame[t]) +
+                      tets_.kappa[t] * (debar_[g] * dilatation_gradient(s) + ebar_[g] * dilatation_dgradient(s, dF_[t]));
+      const auto fe = nodal_forces(dP, tets_.rest[t]);   // −V₀ δP D_m⁻ᵀ: the forces' change, −K p
       for (int i = 0; i < 4; ++i) tet_f_[4 * t + i] = -fe[i];
     }
     kp.resize(N);
@@ -118,14 +103,14 @@ class FemForceField final : public ForceField {
     // dilatation (the cube coupling left out: this is only the preconditioner).
     blocks.assign(m_.node_count(), Mat3::Zero());
     for (std::size_t t = 0; t < m_.tets.size(); ++t) {
-      const Mat3& Dinv = rest_[t].dm_inverse;
+      const Mat3& Dinv = tets_.rest[t].dm_inverse;
       // ∂F/∂x_i along axis a is e_a ⊗ ∇N_i, with ∇N_i the rows of D_m⁻¹ (vertex 0: minus their sum).
       const Vec3 grads[4] = {-(Dinv.row(0) + Dinv.row(1) + Dinv.row(2)).transpose(), Dinv.row(0).transpose(),
                              Dinv.row(1).transpose(), Dinv.row(2).transpose()};
       for (int i = 0; i < 4; ++i)
         for (int a = 0; a < 3; ++a) {
           const Mat3 dF = Vec3::Unit(a) * grads[i].transpose();
-          const Vec3 col = rest_[t].volume_m3 * dpiola(state_[t], dF, lame_[t]) * grads[i];
+          const Vec3 col = tets_.rest[t].volume_m3 * dpiola(state_[t], dF, tets_.lame[t]) * grads[i];
           blocks[m_.tets[t][i]].col(a) += col;
         }
     }
@@ -143,46 +128,25 @@ class FemForceField final : public ForceField {
     return sum;
   }
 
-  // The groups of the mean dilatation: the tetrahedra of one cube and part, or each alone.
-  void build_groups(bool mean_dilatation) {
-    const int64_t T = int64_t(m_.tets.size());
-    std::vector<int32_t> order(T);
-    std::iota(order.begin(), order.end(), 0);
-    auto key = [&](int32_t t) { return mean_dilatation ? m_.tet_cube[t] * 2 + int64_t(m_.tet_part[t]) : int64_t(t); };
-    std::stable_sort(order.begin(), order.end(), [&](int32_t a, int32_t b) { return key(a) < key(b); });
-    group_of_tet_.assign(T, 0);
-    group_tets_ = order;
-    group_begin_.clear();
-    for (int64_t i = 0; i < T; ++i) {
-      if (i == 0 || key(order[i]) != key(order[i - 1])) group_begin_.push_back(int32_t(i));
-      group_of_tet_[order[i]] = int32_t(group_begin_.size() - 1);
-    }
-    group_begin_.push_back(int32_t(T));
-    group_weight_.assign(group_begin_.size() - 1, 0.0);
-    for (int64_t t = 0; t < T; ++t) group_weight_[group_of_tet_[t]] += kappa_[t] * rest_[t].volume_m3;
-    grouped_by_cube_ = mean_dilatation;
-    groups_built_ = true;
-  }
-
   // The element states at x. Newton linearises at the point its line search last evaluated: the
   // states are kept with that point and its model, so the polar decompositions are not done twice.
   void update_states(const ForceModel& model, const std::vector<Vec3>& x) {
-    if (!groups_built_ || grouped_by_cube_ != model.mean_dilatation) {
-      build_groups(model.mean_dilatation);
+    if (!groups_ || groups_->by_cube != model.mean_dilatation) {
+      groups_.emplace(m_, tets_, model.mean_dilatation);
       states_x_.clear();
     }
     if (model.stiffening == states_stiffening_ && x == states_x_) return;
     states_x_ = x;
     states_stiffening_ = model.stiffening;
     const int64_t T = int64_t(m_.tets.size());
-    if (law_of(model.material) != law_)
+    if (fem_law_of(model.material) != law_)
       throw std::logic_error("FemForceField: built for one law, asked for another");
     const FemLaw law = law_;
     state_.resize(T);
 #pragma omp parallel for schedule(static) if (T > 20000)
     for (int64_t t = 0; t < T; ++t) {
       const auto& q = m_.tets[t];
-      const Mat3 F = edge_matrix(x[q[0]], x[q[1]], x[q[2]], x[q[3]]) * rest_[t].dm_inverse;
+      const Mat3 F = edge_matrix(x[q[0]], x[q[1]], x[q[2]], x[q[3]]) * tets_.rest[t].dm_inverse;
       state_[t] = element_state(law, F, model.stiffening);
     }
     // An inverted neo-Hookean element has no dilatation: NaN reaches its forces and the solver.
@@ -192,40 +156,37 @@ class FemForceField final : public ForceField {
   // out[g] = Σ_t w_t q(t) / Λ_g over the tetrahedra of group g (0 for a group without volumetric stiffness).
   template <class PerTet>
   void group_average(PerTet&& q, std::vector<double>& out) const {
-    const int64_t G = int64_t(group_weight_.size());
+    const int64_t G = int64_t(groups_->weight.size());
     out.assign(G, 0.0);
 #pragma omp parallel for schedule(static) if (G > 20000)
     for (int64_t g = 0; g < G; ++g) {
       double sum = 0.0;
-      for (int32_t i = group_begin_[g]; i < group_begin_[g + 1]; ++i) {
-        const int32_t t = group_tets_[i];
-        sum += kappa_[t] * rest_[t].volume_m3 * q(t);
+      for (int32_t i = groups_->begin[g]; i < groups_->begin[g + 1]; ++i) {
+        const int32_t t = groups_->tets[i];
+        sum += tets_.kappa[t] * tets_.rest[t].volume_m3 * q(t);
       }
-      out[g] = group_weight_[g] > 0.0 ? sum / group_weight_[g] : 0.0;
+      out[g] = groups_->weight[g] > 0.0 ? sum / groups_->weight[g] : 0.0;
     }
   }
 
   const Mesh& m_;
   FemLaw law_;
   Adjacency adj_;
-  std::vector<TetRest> rest_;
-  std::vector<Lame> lame_;
-  std::vector<double> kappa_;   // volumetric modulus of the law (fem_element.h), per tetrahedron
+  FemTets tets_;
+  std::optional<FemGroups> groups_;   // built for the model's mean_dilatation
   std::vector<ElementState> state_;
-  std::vector<int32_t> group_of_tet_, group_tets_, group_begin_;
-  std::vector<double> group_weight_, ebar_, debar_;
+  std::vector<double> ebar_, debar_;
   std::vector<Mat3> dF_;
   std::vector<Vec3> tet_f_, load_f_;
   std::vector<Vec3> states_x_;        // the positions state_ and ebar_ belong to
   double states_stiffening_ = NAN;
-  bool groups_built_ = false, grouped_by_cube_ = false;
   int64_t evaluations_ = 0;
 };
 
 }  // namespace
 
 std::unique_ptr<ForceField> make_fem_force_field(const Mesh& m, MaterialModel model) {
-  return std::make_unique<FemForceField>(m, law_of(model));
+  return std::make_unique<FemForceField>(m, fem_law_of(model));
 }
 
 }  // namespace pneumo
