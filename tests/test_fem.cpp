@@ -14,9 +14,11 @@
 #include "solve/fem_element.h"
 #include "solve/force_field.h"
 #include "solve/pressure_stiffness.h"
+#include "solve/solve_on_device.h"
 #include "solve/solver.h"
 #include "validate/validate.h"
 #include "mesh_test_support.h"
+#include "opencl_test_support.h"
 
 namespace pneumo {
 namespace {
@@ -292,9 +294,11 @@ TEST(FemField, RigidMotionOfTheMeshGivesNoForce) {
 TEST(FemField, PatchTestReproducesAUniformStrainExactly) {
   // The patch test: the boundary nodes of a solid block held at x = A x₀ (a uniform strain of up to 5 %
   // with a rotation), the interior nodes started off it at random; Newton must put every interior node
-  // on A x₀. Compared: interior positions against A x₀. Tolerance 1e-9 m (of 5 mm cubes), where the
-  // solver's residual tolerance 1e-10 leaves sub-nanometre errors; a scheme that fails the patch test
-  // is off by micrometres or more.
+  // on A x₀. Compared: interior positions against A x₀, on the CPU and on every OpenCL device.
+  // Tolerance on the CPU 1e-9 m (of 5 mm cubes), where the solver's residual tolerance 1e-10 leaves
+  // sub-nanometre errors; on a device (float32) 1e-7 m to a residual of 1e-3 (this residual is relative
+  // to the forces of a 0.1 % strain, so float rounding floors it near 1e-4): the rounding of
+  // millimetre displacements. A scheme that fails the patch test is off by micrometres or more.
   std::mt19937 rng(kSeed + 6);
   Mesh m = block_mesh(4, 1, /*shell=*/false);
   const Mat3 A = rotation(Vec3(1, 1, 0), 0.3) * (Mat3::Identity() + random_matrix(rng, 0.05));
@@ -312,20 +316,24 @@ TEST(FemField, PatchTestReproducesAUniformStrainExactly) {
   }
   ASSERT_GT(interior, 20);
   Progress::set_enabled(false);
-  for (const FieldCase& c : kFields) {
-    if (c.model == MaterialModel::Msd) continue;
-    SCOPED_TRACE(c.name);
-    SolveOptions o;
-    o.method = SolverMethod::Newton;
-    o.forces = elastic_only(c);
-    o.residual_tolerance = 1e-10;
-    o.progress = false;
-    const SolveResult r = solve(m, o, start);
-    EXPECT_TRUE(r.converged) << r.stop_reason;
-    double worst = 0.0;
-    for (int64_t n = 0; n < m.node_count(); ++n) worst = std::max(worst, (r.x[n] - A * m.rest_m[n]).norm());
-    EXPECT_LT(worst, 1e-9);
-  }
+  for (const std::string& device : testing_support::cpu_and_opencl_device_specs())
+    for (const FieldCase& c : kFields) {
+      if (c.model == MaterialModel::Msd) continue;
+      SCOPED_TRACE(std::string(c.name) + " on " + device);
+      SolveOptions o;
+      o.method = SolverMethod::Newton;
+      o.forces = elastic_only(c);
+      o.residual_tolerance = device == "cpu" ? 1e-10 : 1e-3;
+      o.progress = false;
+      std::shared_ptr<ocl::Context> ctx;
+      if (device != "cpu") ctx = ocl::Context::shared(ocl::parse_device_spec(device));
+      const SolveResult r = solve_on_device(ctx.get(), m, o, start);
+      EXPECT_TRUE(r.converged) << r.stop_reason << ", residual " << r.residual;
+      double worst = 0.0;
+      for (int64_t n = 0; n < m.node_count(); ++n) worst = std::max(worst, (r.x[n] - A * m.rest_m[n]).norm());
+      std::printf("%s on %s: %lld iterations, worst %.2g m\n", c.name, device.c_str(), (long long)r.steps, worst);
+      EXPECT_LT(worst, device == "cpu" ? 1e-9 : 1e-7);
+    }
 }
 
 TEST(NewtonSolver, ReachesTheStaticSolversEquilibriumOnTheSprings) {
@@ -388,6 +396,33 @@ TEST(FemLame, HollowSphereMatchesLamesClosedFormAndConverges) {
       previous_outer = std::abs(r.rel_error_outer);
     }
   }
+}
+
+TEST(FemLame, EveryDeviceGivesTheCpusSphere) {
+  // Lamé's sphere at 10 mm cubes (ν = 0.45, one placement) solved on every OpenCL device (float32)
+  // and on the CPU (double), both laws, to a residual of 1e-5. Compared: the surface-mean inner and
+  // outer displacements, device against CPU. Tolerance 1e-4 relative: float rounding of the forces
+  // and the residual's share of a millimetre; a wrong element, group or load on the device is off by
+  // per cents. The CPU's own distance to the closed form is the test above.
+  Progress::set_enabled(false);
+  for (const std::string& device : testing_support::opencl_device_specs())
+    for (MaterialModel model : {MaterialModel::FemCorotational, MaterialModel::FemNeoHookean}) {
+      SCOPED_TRACE(std::string(enum_name(model)) + " on " + device);
+      LameOptions o;
+      o.model = model;
+      o.poisson = 0.45;
+      o.cube_mm = 10.0;
+      o.placements = 1;
+      o.residual_tolerance = 1e-5;
+      const LameResult cpu = validate_lame_sphere(o);
+      o.device = device;
+      const LameResult dev = validate_lame_sphere(o);
+      std::printf("%s on %s: inner %.6f / %.6f mm, outer %.6f / %.6f mm (device / cpu), %lld / %lld iterations\n",
+                  enum_name(model), device.c_str(), dev.u_inner_mm, cpu.u_inner_mm, dev.u_outer_mm, cpu.u_outer_mm,
+                  (long long)dev.steps, (long long)cpu.steps);
+      EXPECT_NEAR(dev.u_inner_mm, cpu.u_inner_mm, 1e-4 * cpu.u_inner_mm);
+      EXPECT_NEAR(dev.u_outer_mm, cpu.u_outer_mm, 1e-4 * cpu.u_outer_mm);
+    }
 }
 
 }  // namespace

@@ -104,10 +104,16 @@ CgOutcome conjugate_gradients(const Mesh& m, ForceField& field, const PressureSt
 }  // namespace
 
 SolveResult solve_newton(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x) {
+  const std::unique_ptr<ForceField> field = make_force_field(m, opt.forces);
+  return solve_newton_on(m, opt, *field, x);
+}
+
+SolveResult solve_newton_on(const Mesh& m, const SolveOptions& opt, ForceField& field,
+                            const std::vector<Vec3>& x_start) {
+  std::vector<Vec3> x = x_start.empty() ? m.rest_m : x_start;
   SolveResult r;
   detail::Monitor mon(m, opt, "newton", r);
   const int64_t N = m.node_count();
-  const std::unique_ptr<ForceField> field = make_force_field(m, opt.forces);
   ForceModel model = opt.forces;
   model.damping = false;
   const int increments = detail::load_increments(opt);
@@ -126,16 +132,16 @@ SolveResult solve_newton(const Mesh& m, const SolveOptions& opt, std::vector<Vec
     model.pressure_pa = detail::increment_pressure(opt, inc, increments);
     const bool last = inc == increments;
     const double tol = opt.residual_tolerance * (last ? 1.0 : detail::Fire::kIntermediateToleranceFactor);
-    field->evaluate(model, x, {}, f);
+    field.evaluate(model, x, {}, f);
     detail::apply_holds(m, f);
     residual = mon.residual(f);
     double norm = std::sqrt(dot(f, f)), previous_norm = NAN;
     int64_t inverted = count_inverted(m, x);
     bool increment_done = residual < tol;
     while (!increment_done && step < opt.max_steps) {
-      field->linearize(model, x);
+      field.linearize(model, x);
       pressure.linearize(m, x, model.pressure_pa);
-      field->stiffness_diagonal(blocks);
+      field.stiffness_diagonal(blocks);
       const std::vector<Mat3> precond = block_jacobi(m, blocks);
       const double eta = std::isfinite(previous_norm)
                              ? std::clamp(0.9 * (norm / previous_norm) * (norm / previous_norm), 1e-3, 0.1)
@@ -143,7 +149,7 @@ SolveResult solve_newton(const Mesh& m, const SolveOptions& opt, std::vector<Vec
       // At negative curvature: the shifted system K + σ D (above).
       CgOutcome cg;
       for (;;) {
-        cg = conjugate_gradients(m, *field, pressure, precond, blocks, shift, f, eta, opt.newton_max_cg_iterations, d);
+        cg = conjugate_gradients(m, field, pressure, precond, blocks, shift, f, eta, opt.newton_max_cg_iterations, d);
         cg_iterations += cg.iterations;
         if (!cg.negative_curvature) break;
         shift = shift > 0.0 ? 10.0 * shift : kFirstShift;
@@ -156,7 +162,7 @@ SolveResult solve_newton(const Mesh& m, const SolveOptions& opt, std::vector<Vec
       bool accepted = false;
       for (int tries = 0; tries < 12; ++tries, alpha *= 0.5) {
         for (int64_t n = 0; n < N; ++n) trial[n] = x[n] + alpha * d[n];
-        field->evaluate(model, trial, {}, f_trial);
+        field.evaluate(model, trial, {}, f_trial);
         detail::apply_holds(m, f_trial);
         trial_norm = std::sqrt(dot(f_trial, f_trial));
         if (!(std::isfinite(trial_norm) && trial_norm <= (1.0 - 1e-4 * alpha) * norm)) continue;
@@ -182,7 +188,7 @@ SolveResult solve_newton(const Mesh& m, const SolveOptions& opt, std::vector<Vec
   }
   r.final_pressure_pa = model.pressure_pa;
   r.inner_iterations = cg_iterations;
-  mon.finish(x, {}, step, field->evaluations(), converged, reason, residual);
+  mon.finish(x, {}, step, field.evaluations(), converged, reason, residual);
   return r;
 }
 

@@ -3,22 +3,30 @@
 #include <atomic>
 
 #include "core/log.h"
+#include "solve/fem_force_field_cl.h"
+#include "solve/force_field.h"
 #include "solve/solver_cl.h"
 
 namespace pneumo {
 
 bool device_implements(const SolveOptions& opt) {
-  return opt.method != SolverMethod::Newton && opt.forces.material == MaterialModel::Msd;
+  const bool fem = opt.forces.material != MaterialModel::Msd;
+  return opt.method == SolverMethod::Newton ? fem : !fem;
 }
 
 SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions& opt,
                             const std::vector<Vec3>& x_start) {
-  if (ctx && device_implements(opt)) return solve_opencl(*ctx, m, opt, x_start);
+  if (ctx && device_implements(opt)) {
+    if (opt.method != SolverMethod::Newton) return solve_opencl(*ctx, m, opt, x_start);
+    const std::unique_ptr<ForceField> field = make_fem_force_field_cl(*ctx, m, opt.forces.material);
+    return solve_newton_on(m, opt, *field, x_start);
+  }
   if (ctx) {
     static std::atomic<bool> said{false};
     if (!said.exchange(true))
-      log::info(std::string("solving on the CPU: the OpenCL solvers implement the springs' four schemes, not ") +
-                (opt.method == SolverMethod::Newton ? "newton" : enum_name(opt.forces.material)));
+      log::info(std::string("solving on the CPU: on OpenCL, newton solves the finite elements and the other "
+                            "schemes the springs, not ") +
+                enum_name(opt.method) + " with " + enum_name(opt.forces.material));
   }
   return solve(m, opt, x_start);
 }

@@ -8,8 +8,9 @@
 
 namespace pneumo {
 
-/// Whether the OpenCL solvers (solver_cl.h) implement this method and material model: the four
-/// spring solvers do; Newton and the finite elements run on the CPU.
+/// Whether OpenCL implements this method and material model: the springs' four schemes
+/// (solver_cl.h) and Newton on the finite elements (fem_force_field_cl.h, the conjugate gradients on
+/// the host); Newton on the springs runs on the CPU.
 bool device_implements(const SolveOptions& opt);
 
 /// Solves on `ctx` when it is given and implements the options, on the CPU otherwise (saying so

@@ -89,4 +89,10 @@ double ramp_factor(double t_s, double ramp_s, RampShape shape);
 /// Runs the chosen solver from `x_start` (rest positions when empty).
 SolveResult solve(const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x_start = {});
 
+class ForceField;
+/// Newton (solve_newton.cpp) on a given force field, e.g. one on an OpenCL device
+/// (fem_force_field_cl.h); x_start empty is the rest state.
+SolveResult solve_newton_on(const Mesh& m, const SolveOptions& opt, ForceField& field,
+                            const std::vector<Vec3>& x_start = {});
+
 }  // namespace pneumo

@@ -6,6 +6,7 @@
 
 
 #include "core/units.h"
+#include "solve/solve_on_device.h"
 #include "validate/validate.h"
 
 namespace pneumo {
@@ -92,7 +93,9 @@ PlacementMeans solve_placement(const LameOptions& o, const Vec3& offset_cubes) {
   so.forces.pressure_pa = units::mmhg_to_pa(o.pressure_mmhg) * o.solve_fraction;
   so.residual_tolerance = o.residual_tolerance;
   so.max_steps = 500000;
-  const SolveResult r = solve(m, so);
+  std::shared_ptr<ocl::Context> ctx;
+  if (const ocl::DeviceSpec spec = ocl::parse_device_spec(o.device); spec.use_opencl) ctx = ocl::Context::shared(spec);
+  const SolveResult r = solve_on_device(ctx.get(), m, so);
 
   PlacementMeans out;
   double sum_a[2] = {0, 0}, w_a[2] = {0, 0}, sum_n[2] = {0, 0};
@@ -166,6 +169,7 @@ LameResult validate_lame_sphere(const LameOptions& o) {
 
 nlohmann::json to_json(const LameResult& r) {
   return {{"model", enum_name(r.options.model)},
+          {"device", r.options.device},
           {"poisson_ratio", r.options.model == MaterialModel::Msd ? 0.25 : r.options.poisson},
           {"mean_dilatation", r.options.mean_dilatation},
           {"cube_mm", r.options.cube_mm},

@@ -42,6 +42,7 @@ struct LameOptions {
   MaterialModel model = MaterialModel::Msd;   // the finite elements are solved by Newton
   double poisson = 0.25;             // the finite elements' ν (the springs' is 1/4 whatever this says)
   bool mean_dilatation = true;
+  std::string device = "cpu";        // "cpu" or an OpenCL spec (solve_on_device.h)
 };
 struct LameResult {
   LameOptions options;
