@@ -34,6 +34,32 @@ double max_gradient_mismatch(const std::vector<Vec3>& x, const std::vector<Vec3>
   return worst;
 }
 
+/// A random voxel grid (3 … max_dim voxels per axis, 1–4 mm spacing, anywhere within 100 mm of the
+/// origin) of random roles and labels 0–3, voxel 0 wall so the mesh is never empty, and a random cube
+/// size of 1 or 2 voxels: the meshes the device-equality tests draw.
+struct RandomVoxels {
+  Geometry grid;
+  std::vector<Role> roles;
+  std::vector<uint16_t> labels;
+  MeshOptions options;
+  VoxelRoles view() const { return VoxelRoles{grid, roles.data(), labels.data()}; }
+};
+inline RandomVoxels random_voxels(std::mt19937& rng, int max_dim) {
+  std::uniform_int_distribution<int> dim(3, max_dim), role(0, 3), cube(1, 2);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  RandomVoxels v;
+  v.grid.dims = {dim(rng), dim(rng), dim(rng)};
+  v.grid.spacing_mm = Vec3(1.0 + 3 * u(rng), 1.0 + 3 * u(rng), 1.0 + 3 * u(rng));
+  v.grid.origin_mm = Vec3(-100 + 200 * u(rng), -100 + 200 * u(rng), -100 + 200 * u(rng));
+  v.roles.resize(v.grid.voxel_count());
+  v.labels.resize(v.grid.voxel_count());
+  for (auto& r : v.roles) r = Role(role(rng));
+  v.roles[0] = Role::Wall;
+  for (auto& l : v.labels) l = uint16_t(rng() % 4);
+  v.options.cube_voxels = cube(rng);
+  return v;
+}
+
 inline std::vector<Vec3> perturbed(const Mesh& m, std::mt19937& rng, double amplitude_m) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::vector<Vec3> x = m.rest_m;

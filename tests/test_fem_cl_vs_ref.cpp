@@ -17,6 +17,7 @@
 
 #include "cl/cl_runtime.h"
 #include "mesh/adjacency.h"
+#include "mesh_test_support.h"
 #include "opencl_test_support.h"
 #include "solve/fem_element.h"
 #include "solve/fem_force_field_cl.h"
@@ -35,22 +36,13 @@ struct RandomCase {
 };
 
 RandomCase random_case(std::mt19937& rng) {
-  std::uniform_int_distribution<int> dim(3, 7), role(0, 3), cube(1, 2);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  Geometry g;
-  g.dims = {dim(rng), dim(rng), dim(rng)};
-  g.spacing_mm = Vec3(1.0 + 3 * u(rng), 1.0 + 3 * u(rng), 1.0 + 3 * u(rng));
-  g.origin_mm = Vec3(-100 + 200 * u(rng), -100 + 200 * u(rng), -100 + 200 * u(rng));
-  std::vector<Role> roles(g.voxel_count());
-  std::vector<uint16_t> labels(g.voxel_count());
-  for (auto& r : roles) r = Role(role(rng));
-  roles[0] = Role::Wall;   // never an empty mesh
-  for (auto& l : labels) l = uint16_t(rng() % 4);
-  MeshOptions mo;
-  mo.cube_voxels = cube(rng);
+  const RandomVoxels vox = random_voxels(rng, 7);
+  const Geometry& g = vox.grid;
+  const MeshOptions& mo = vox.options;
   const double young[4] = {2e3 + 80e3 * u(rng), 2e3 + 80e3 * u(rng), 20e3 + 80e3 * u(rng), 20e3 + 80e3 * u(rng)};
   RandomCase c;
-  c.mesh = build_mesh(VoxelRoles{g, roles.data(), labels.data()}, mo, [&](Role, int label) { return young[label]; });
+  c.mesh = build_mesh(vox.view(), mo, [&](Role, int label) { return young[label]; });
   assign_material(c.mesh, MaterialOptions{});
   c.mesh.tet_poisson.resize(c.mesh.tets.size());
   for (auto& nu : c.mesh.tet_poisson) nu = 0.2 + 0.29 * u(rng);
