@@ -169,7 +169,7 @@ const Table<SceneMaterial>& material_table() {
       {"model", &SceneMaterial::model, "", any(),
        "\"msd\": the mass-spring lattice (§4-5); \"fem-corotational\": co-rotational linear tetrahedra (as SOFA, "
        "Bano 2012); \"fem-neohookean\": neo-Hookean tetrahedra, with Demiray's stiffening when stiffening > 0. The "
-       "FEM models need solver.method \"newton\" (docs/fem.md)."},
+       "FEM models need solver.method \"newton\" (the fast choice) or \"static\" (docs/fem.md)."},
       {"poisson_ratio", &SceneMaterial::poisson_ratio, "", in(0, 0.49),
        "ν of the finite elements unless overridden (Bano 2012: 0.49 for the wall); the springs' ν is 1/4."},
       {"wall_poisson_ratio", &SceneMaterial::wall_poisson_ratio, "", in(0, 0.49),
@@ -214,7 +214,8 @@ const Table<SceneSolver>& solver_table() {
       {"method", &SceneSolver::method, "", any(),
        "\"static\": fast equilibrium; \"explicit\": symplectic Euler; \"newmark\": Nimura's Newmark-β; "
        "\"kitasaka2004\": Kitasaka's quasi-static scheme (§6); \"newton\": Newton with preconditioned conjugate "
-       "gradients (static; CPU; every material model)."},
+       "gradients (static; every material model; on OpenCL for the finite elements). The finite elements "
+       "take \"static\" or \"newton\"."},
       {"dt_ms", &SceneSolver::dt_ms, "ms", in(0, 1000),
        "Time step of explicit and newmark; 0 = dt_safety × the stability bound (§6)."},
       {"dt_safety", &SceneSolver::dt_safety, "", above(0, 1), "Fraction of the stability bound used when dt_ms = 0."},

@@ -145,6 +145,11 @@ class ClFemForceField final : public ForceField {
       for (int a = 0; a < 3; ++a) blocks[n].col(a) = Vec3(raw[3 * n + a].s[0], raw[3 * n + a].s[1], raw[3 * n + a].s[2]);
   }
 
+  std::vector<double> fire_masses(const ForceModel& model) override {
+    // Computed once on the host, from the rest state: the bound does not depend on the device.
+    return make_fem_force_field(m_, model.material)->fire_masses(model);
+  }
+
   int64_t evaluations() const override { return evaluations_; }
 
  private:

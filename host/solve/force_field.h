@@ -33,6 +33,10 @@ class ForceField {
   virtual void stiffness_product(const std::vector<Vec3>& p, std::vector<Vec3>& kp) = 0;
   /// The 3×3 diagonal blocks K_nn at the last linearisation, one per node.
   virtual void stiffness_diagonal(std::vector<Mat3>& blocks) = 0;
+  /// FIRE's fictitious masses (solve_static_fire.cpp): per node a mass m_i with Σ_j |K_ij| ≤ 2 m_i on
+  /// each of its three rows of the stiffness at rest (Gershgorin), so every mode has ω² ≤ 2 whatever
+  /// the mesh, cube size or moduli. Never zero (a node without stiffness gets 1).
+  virtual std::vector<double> fire_masses(const ForceModel& model) = 0;
   /// Force evaluations so far (stiffness products not counted).
   virtual int64_t evaluations() const = 0;
 };

@@ -4,12 +4,14 @@
 // Why FIRE: only the final shape matters for planning; FIRE is a force-only accelerated descent
 // (≈√κ iterations where plain descent needs κ), it never climbs (it stops and restarts whenever the
 // power F·v turns negative), and with fictitious masses m_i = Σ_j k_ij (Gershgorin: ω_max² ≤ 2)
-// one set of parameters serves every mesh size, cube size and stiffness. Follower pressure is
+// one set of parameters serves every mesh size, cube size and stiffness (any force field: the springs
+// or the finite elements, force_field.h, each giving its own bound). Follower pressure is
 // non-conservative, but FIRE needs no energy, only forces. The load is applied in increments of at
 // most kMaxIncrementMmHg, each relaxed before the next, so large pressures do not invert
 // tetrahedra on the way.
 #include <cmath>
 
+#include "solve/force_field.h"
 #include "solve/solver_common.h"
 
 namespace pneumo {
@@ -20,9 +22,8 @@ SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vecto
   SolveResult r;
   detail::Monitor mon(m, opt, "static", r);
   const int64_t N = m.node_count();
-  const std::vector<double> mass = detail::fire_masses(m, opt);
-
-  ForceEvaluator eval(m);
+  const std::unique_ptr<ForceField> field = make_force_field(m, opt.forces);
+  const std::vector<double> mass = field->fire_masses(opt.forces);
   ForceModel model = opt.forces;
   model.damping = false;
   const int increments = detail::load_increments(opt);
@@ -39,7 +40,7 @@ SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vecto
     const double tol = opt.residual_tolerance * (last ? 1.0 : F::kIntermediateToleranceFactor);
     detail::FireControl fire;
     std::fill(v.begin(), v.end(), Vec3::Zero());
-    eval.evaluate(model, x, {}, f);
+    field->evaluate(model, x, {}, f);
     detail::apply_holds(m, f);
     bool increment_done = false;
     while (step < opt.max_steps) {
@@ -60,7 +61,7 @@ SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vecto
           for (int64_t n = 0; n < N; ++n) v[n] = (1.0 - alpha) * v[n] + alpha * vnorm / fnorm * f[n];
       }
       for (int64_t n = 0; n < N; ++n) x[n] += dt * v[n];
-      eval.evaluate(model, x, {}, f);
+      field->evaluate(model, x, {}, f);
       detail::apply_holds(m, f);
       ++step;
       if (step % opt.monitor_every == 0 || step == opt.max_steps) {
@@ -75,7 +76,7 @@ SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vecto
     if (!increment_done) break;
   }
   r.final_pressure_pa = model.pressure_pa;
-  mon.finish(x, {}, step, eval.evaluations(), converged, reason, residual);
+  mon.finish(x, {}, step, field->evaluations(), converged, reason, residual);
   return r;
 }
 

@@ -242,7 +242,7 @@ SolveResult static_fire_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions&
   using F = detail::Fire;
   SolveResult r;
   detail::Monitor mon(m, opt, "static", r);
-  Device d(ctx, m, detail::fire_masses(m, opt));
+  Device d(ctx, m, detail::fire_masses(m, opt.forces));
   d.eval.upload_state(x0, std::vector<Vec3>(x0.size(), Vec3::Zero()));
   cl::Buffer &x = d.eval.positions(), &v = d.eval.velocities(), &f = d.eval.forces();
   cl::Kernel mask = d.kernel("mask_forces"), sums = d.kernel("fire_sums"), restart = d.kernel("fire_restart"),

@@ -10,14 +10,14 @@
 
 namespace pneumo::detail {
 
-std::vector<double> fire_masses(const Mesh& m, const SolveOptions& opt) {
+std::vector<double> fire_masses(const Mesh& m, const ForceModel& model) {
   std::vector<double> mass = stiffness_sums(m);
-  if (opt.forces.volume_stiffness_pa != 0.0)
+  if (model.volume_stiffness_pa != 0.0)
     for (std::size_t t = 0; t < m.tets.size(); ++t) {
       const auto& q = m.tets[t];
       const auto g = tet_volume_gradient(m.rest_m[q[0]], m.rest_m[q[1]], m.rest_m[q[2]], m.rest_m[q[3]]);
       for (int i = 0; i < 4; ++i)
-        mass[q[i]] += std::abs(opt.forces.volume_stiffness_pa) * g[i].squaredNorm() / m.tet_rest_volume_m3[t];
+        mass[q[i]] += std::abs(model.volume_stiffness_pa) * g[i].squaredNorm() / m.tet_rest_volume_m3[t];
     }
   for (auto& w : mass) w = w > 0.0 ? w : 1.0;
   return mass;

@@ -80,8 +80,9 @@ class NewmarkInnerLoop {
   int growing_ = 0, iterations_ = 0;
 };
 
-/// FIRE's fictitious masses: each node's spring stiffness sum (plus the volume term's, when on).
-std::vector<double> fire_masses(const Mesh& m, const SolveOptions& opt);
+/// The springs' FIRE masses (ForceField::fire_masses): each node's spring stiffness sum (plus the
+/// volume term's, when on).
+std::vector<double> fire_masses(const Mesh& m, const ForceModel& model);
 /// Number of load increments for the static solver (from start_pressure_pa to the target).
 int load_increments(const SolveOptions& opt);
 /// The pressure of load increment k of n (k = n: the target).

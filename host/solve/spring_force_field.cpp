@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "solve/force_field.h"
+#include "solve/solver_common.h"
 
 namespace pneumo {
 
@@ -20,6 +21,8 @@ class SpringForceField final : public ForceField {
                 std::vector<Vec3>& f) override {
     eval_.evaluate(model, x, v, f);
   }
+
+  std::vector<double> fire_masses(const ForceModel& model) override { return detail::fire_masses(m_, model); }
 
   double elastic_energy(const ForceModel& model, const std::vector<Vec3>& x) override {
     return spring_energy(m_, x, model.spring_model, model.stiffening) +
