@@ -18,6 +18,7 @@
 #include "pipeline/simulate.h"
 #include "pipeline/warp_stage.h"
 #include "scene/scene.h"
+#include "solve/fem_force_field_cl.h"
 #include "solve/solver_cl.h"
 #include "tiny_case_support.h"
 #include "warp/warp.h"
@@ -89,6 +90,30 @@ TEST_P(DeviceMemoryEstimate, EverySolverAllocatesNoMoreThanItsEstimate) {
   // Not a refusal of cases that fit: the estimate bounds each block's spring records by the mesh's
   // largest node degree, which overstates, but by less than twice what the hungriest solver allocates.
   EXPECT_LT(estimate, 2 * most) << "the estimate would refuse meshes that fit";
+}
+
+TEST_P(DeviceMemoryEstimate, TheFiniteElementsAllocateNoMoreThanTheirEstimate) {
+  // The OpenCL finite elements (fem_force_field_cl.h): everything their construction, an evaluation,
+  // a stiffness product and the diagonal blocks create, against fem_force_field_cl_bytes; and the
+  // estimate within twice of it (it bounds the groups by one per tetrahedron).
+  const uint64_t estimate = fem_force_field_cl_bytes(sim_.mesh);
+  ForceModel model;
+  model.material = MaterialModel::FemNeoHookean;
+  model.pressure_pa = 1600.0;
+  const uint64_t allocated = allocated_by([&] {
+    auto field = make_fem_force_field_cl(*ctx_, sim_.mesh, model.material);
+    std::vector<Vec3> f, kp;
+    std::vector<Mat3> blocks;
+    field->evaluate(model, sim_.mesh.rest_m, {}, f);
+    field->linearize(model, sim_.mesh.rest_m);
+    field->stiffness_product(f, kp);
+    field->stiffness_diagonal(blocks);
+  });
+  std::printf("finite elements: %llu bytes allocated, %llu estimated\n", (unsigned long long)allocated,
+              (unsigned long long)estimate);
+  EXPECT_GT(allocated, 0u);
+  EXPECT_LE(allocated, estimate);
+  EXPECT_LT(estimate, 2 * allocated) << "the estimate would refuse meshes that fit";
 }
 
 TEST_P(DeviceMemoryEstimate, TheWarpAllocatesExactlyItsEstimate) {
