@@ -37,8 +37,8 @@ TEST(BenchSmoke, QuickRunWritesEverySectionWithFiniteNumbers) {
   ASSERT_EQ(r.code, 0) << r.err;
   const json doc = json::parse(slurp(js));
 
-  for (const char* key : {"schema", "machine", "bandwidth", "throughput", "speed_accuracy", "stability", "notes",
-                          "wall_time_s"})
+  for (const char* key : {"schema", "machine", "bandwidth", "throughput", "speed_accuracy", "stability",
+                          "material_models", "notes", "wall_time_s"})
     EXPECT_TRUE(doc.contains(key)) << key;
   std::vector<std::string> bad;
   non_finite(doc, "", bad);
@@ -105,6 +105,19 @@ TEST(BenchSmoke, QuickRunWritesEverySectionWithFiniteNumbers) {
     EXPECT_GT(row["dt_unstable_ms"].get<double>(), row["dt_stable_ms"].get<double>());
   }
 
+  // Material models: the springs and both laws on Lamé's sphere within the closed form's reach at 10 mm
+  // cubes (the FEM tests hold them tighter), every FEM law on every OpenCL device, and element rates.
+  const json& mm = doc["material_models"];
+  ASSERT_GE(mm["lame"].size(), 3u);
+  for (const json& row : mm["lame"]) {
+    EXPECT_LT(std::abs(row["rel_error_inner"].get<double>()), 0.1) << row.dump();
+    EXPECT_LT(std::abs(row["rel_error_outer"].get<double>()), 0.1) << row.dump();
+  }
+  ASSERT_EQ(mm["throughput"]["rows"].size(), c["devices"].size());   // every device the throughput measured
+  for (const json& row : mm["throughput"]["rows"]) EXPECT_GT(row["evaluate_element_updates_per_s"].get<double>(), 0);
+  EXPECT_EQ(mm["choice"].size(), 3u);
+
   EXPECT_NE(slurp(md).find("## Speed against accuracy"), std::string::npos);
+  EXPECT_NE(slurp(md).find("## Material models"), std::string::npos);
   EXPECT_NE(slurp(tmp.file("bench.svg")).find("<svg"), std::string::npos);
 }

@@ -163,6 +163,51 @@ void stability(std::ostringstream& md, const json& st) {
   md << "\n";
 }
 
+void material_models(std::ostringstream& md, const json& mm) {
+  md << "## Material models\n\nLamé's hollow sphere (a = 50, b = 100 mm, E = 60 kPa, 10 mmHg, one placement): the "
+        "error of the surface-mean displacement against the closed form with the nominal moduli.\n\n";
+  md << "| model | ν | cube | device | inner | outer | iterations | s |\n|---|---|---|---|---|---|---|---|\n";
+  for (const auto& r : mm["lame"])
+    md << "| " << r["model"].get<std::string>() << " | " << num(r["poisson_ratio"], "%.2f") << " | "
+       << num(r["cube_mm"], "%g") << " mm | " << r["device"].get<std::string>() << " | "
+       << num(json(100 * r["rel_error_inner"].get<double>()), "%+.2f") << " % | "
+       << num(json(100 * r["rel_error_outer"].get<double>()), "%+.2f") << " % | " << r["steps"] << " | "
+       << num(r["wall_s"], "%.2f") << " |\n";
+  if (!mm["real_ct"].empty()) {
+    md << "\nThe real CT at each preset's cube size (all threads):\n\n| preset | model | solver | cube | nodes | s | "
+          "iterations | rise mm | cavity ml | inverted | stop |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& r : mm["real_ct"])
+      md << "| " << r["preset"].get<std::string>() << " | " << r["model"].get<std::string>() << " | "
+         << r["solver"].get<std::string>() << " | " << num(r["cube_mm"], "%g") << " mm | " << r["nodes"] << " | "
+         << num(r["wall_s"], "%.1f") << " | " << (r.contains("steps") ? r["steps"].dump() : "–") << " | "
+         << (r.contains("anterior_rise_mm") ? num(r["anterior_rise_mm"], "%.1f") : "–") << " | "
+         << (r.contains("cavity_volume_ml") ? num(r["cavity_volume_ml"], "%.0f") : "–") << " | "
+         << (r.contains("inverted_tetrahedra") ? r["inverted_tetrahedra"].dump() : "–") << " | "
+         << r["stop_reason"].get<std::string>() << " |\n";
+  }
+  const json& t = mm["throughput"];
+  md << "\nFEM element updates per second (" << t["model"].get<std::string>() << ", " << t["case"].get<std::string>()
+     << " phantom, " << t["nodes"] << " nodes):\n\n| device | evaluate /s | product /s | evaluate / triad | product / "
+        "triad |\n|---|---|---|---|---|\n";
+  for (const auto& r : t["rows"])
+    md << "| " << r["device"].get<std::string>() << " | " << num(r["evaluate_element_updates_per_s"], "%.3g") << " | "
+       << num(r["product_element_updates_per_s"], "%.3g") << " | "
+       << (r.contains("evaluate_fraction_of_triad") ? num(r["evaluate_fraction_of_triad"], "%.2f") : "–") << " | "
+       << (r.contains("product_fraction_of_triad") ? num(r["product_fraction_of_triad"], "%.2f") : "–") << " |\n";
+  md << "\nPeer: " << t["peer"]["source"].get<std::string>() << " (" << t["peer"]["comparable"].get<std::string>()
+     << ").\n\nWhich model for which preset (" << mm["choice_rule"].get<std::string>() << "):\n\n";
+  for (const auto& c : mm["choice"]) {
+    md << "- **" << c["preset"].get<std::string>() << "**: ";
+    if (c["chosen"].is_null()) md << "no real-CT row in this run\n";
+    else
+      md << c["chosen"]["model"].get<std::string>() << " with " << c["chosen"]["solver"].get<std::string>() << ", "
+         << num(c["chosen"]["wall_s"], "%.1f") << " s, Lamé error "
+         << num(json(100 * c["chosen"]["lame_error"].get<double>()), "%.1f") << " %; the preset today: "
+         << c["preset_model"].get<std::string>() << "\n";
+  }
+  md << "\n";
+}
+
 }  // namespace
 
 std::string speed_accuracy_svg(const json& sa) {
@@ -217,6 +262,7 @@ std::string bench_markdown(const json& doc, const std::string& plot_file_name) {
   throughput(md, doc);
   speed_accuracy(md, doc["speed_accuracy"], plot_file_name);
   stability(md, doc["stability"]);
+  material_models(md, doc["material_models"]);
   md << "## Notes\n\n";
   for (const auto& n : doc["notes"]) md << "- " << n.get<std::string>() << "\n";
   return md.str();

@@ -19,6 +19,7 @@
 #include "suite/bench_cases.h"
 #include "suite/bench_context.h"
 #include "suite/bench_report.h"
+#include "suite/material_models.h"
 #include "suite/speed_accuracy.h"
 #include "suite/stability_map.h"
 #include "suite/throughput.h"
@@ -117,6 +118,7 @@ json run_bench(const BenchOptions& opt) {
 
   doc["stability"] = measure_stability_map(ctx);
   doc["speed_accuracy"] = measure_speed_accuracy(ctx);
+  doc["material_models"] = measure_material_models(ctx, opt.real_ct_scene, opt.real_ct_fem_scene);
 
   json cases = json::array();
   // --quick meshes the small phantom with 16 mm cubes (9 k nodes, not its scene's 50 k): seconds, not minutes.

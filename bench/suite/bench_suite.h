@@ -10,6 +10,8 @@
 //   speed_accuracy  solver × cube size × step/tolerance: wall time and the error against a reference solution at
 //                   the same material points, the Pareto front, and the presets it implies
 //   stability       the largest stable Δt of explicit and Newmark-β by bisection against method.md §6's estimate
+//   material_models the springs and the finite elements side by side: Lamé's error, the real CT at each preset,
+//                   element updates per second, and the model each preset should use (material_models.h)
 //   notes           what was skipped and why, and how to read the figures
 #include <string>
 
@@ -20,6 +22,7 @@ namespace pneumo::bench {
 struct BenchOptions {
   bool quick = false;            // the CI smoke run: the small phantom, few repetitions, seconds
   std::string real_ct_scene;     // a scene of the real CT; skipped with a note when it or its CT is missing
+  std::string real_ct_fem_scene; // the same CT with finite elements (the material-model rows)
   std::string json_path, markdown_path;   // "" = not written; the plot goes beside the Markdown as .svg
 };
 

@@ -13,10 +13,14 @@ Run add_bench(CLI::App& app) {
                "steps (a full run takes about 15-20 minutes on 2 cores; --quick is the seconds-long smoke run)");
   auto o = std::make_shared<bench::BenchOptions>();
   o->real_ct_scene = "scenes/totalseg_example.json";
+  o->real_ct_fem_scene = "scenes/totalseg_example_fem.json";
   cmd->add_flag("--quick", o->quick, "Smoke run: the small phantom, few repetitions (checks the harness, not the machine)");
   cmd->add_option("--json", o->json_path, "Write the results as JSON");
   cmd->add_option("--markdown", o->markdown_path, "Write the results as Markdown, and the speed-accuracy plot beside it (.svg)");
   cmd->add_option("--real-ct", o->real_ct_scene, "Scene of the real CT (skipped with a note when it or its CT is missing)")
+      ->capture_default_str();
+  cmd->add_option("--real-ct-fem", o->real_ct_fem_scene,
+                  "The real CT's scene with finite elements, beside the springs' in the material-model rows")
       ->capture_default_str();
   auto peer = std::make_shared<bench::PeerWarpOptions>();
   cmd->add_option("--peer-warp", peer->data_dir,

@@ -1,0 +1,255 @@
+#include "suite/material_models.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "pipeline/simulate.h"
+#include "scene/scene_presets.h"
+#include "solve/fem_force_field_cl.h"
+#include "solve/force_field.h"
+#include "solve/solve_on_device.h"
+#include "suite/bench_cases.h"
+#include "validate/validate.h"
+
+namespace pneumo::bench {
+
+namespace {
+
+using json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+struct ModelCase {
+  MaterialModel model;
+  double poisson;
+};
+
+// The springs' ν is 1/4 whatever is asked; the elements at 1/4 (the springs' own) and 0.45 (muscle and
+// organs, nearly incompressible).
+const ModelCase kLameModels[] = {{MaterialModel::Msd, 0.25},
+                                 {MaterialModel::FemCorotational, 0.25},
+                                 {MaterialModel::FemCorotational, 0.45},
+                                 {MaterialModel::FemNeoHookean, 0.25},
+                                 {MaterialModel::FemNeoHookean, 0.45}};
+
+json lame_row(const ModelCase& mc, double cube_mm, const std::string& device) {
+  LameOptions o;
+  o.model = mc.model;
+  o.poisson = mc.poisson;
+  o.cube_mm = cube_mm;
+  o.placements = 1;
+  o.device = device;
+  const LameResult r = validate_lame_sphere(o);
+  return {{"model", enum_name(mc.model)}, {"poisson_ratio", mc.poisson}, {"cube_mm", cube_mm}, {"device", device},
+          {"rel_error_inner", r.rel_error_inner}, {"rel_error_outer", r.rel_error_outer}, {"nodes", r.nodes},
+          {"steps", r.steps}, {"wall_s", r.wall_time_s}};
+}
+
+json measure_lame(BenchContext& ctx) {
+  json rows = json::array();
+  const std::vector<double> cubes = ctx.quick() ? std::vector<double>{10.0} : std::vector<double>{10.0, 5.0};
+  for (const ModelCase& mc : kLameModels) {
+    if (ctx.quick() && mc.poisson == 0.25 && mc.model != MaterialModel::Msd) continue;
+    for (double cube : cubes) {
+      std::fprintf(stderr, "[bench] models: Lame sphere, %s nu %.2f, %.0f mm cubes, cpu\n", enum_name(mc.model),
+                   mc.poisson, cube);
+      rows.push_back(lame_row(mc, cube, "cpu"));
+    }
+    // The elements on each OpenCL device, at the coarse cube (the fine one is minutes on a CPU device).
+    if (mc.model == MaterialModel::Msd) continue;
+    for (const Device& d : ctx.devices())
+      if (d.opencl()) {
+        std::fprintf(stderr, "[bench] models: Lame sphere, %s nu %.2f, 10 mm cubes, %s\n", enum_name(mc.model),
+                     mc.poisson, d.name.c_str());
+        rows.push_back(lame_row(mc, 10.0, d.info.spec()));
+      }
+  }
+  return rows;
+}
+
+struct TimeLimit {};
+
+json real_ct_row(BenchCase& c, int cube_voxels, SolverMethod method, double limit_s) {
+  if (c.mesh.cube_voxels != cube_voxels) remesh(c, cube_voxels);
+  Scene scene = c.scene;
+  scene.solver.method = method;
+  SolveOptions opt = solve_options_from_scene(scene);
+  opt.progress = false;
+  const auto t0 = Clock::now();
+  opt.snapshot_every_steps = 1;
+  opt.on_snapshot = [&](const SolverSnapshot&) {
+    if (seconds_since(t0) > limit_s) throw TimeLimit{};
+  };
+  json row = {{"model", enum_name(scene.material.model)}, {"solver", enum_name(method)},
+              {"cube_voxels", cube_voxels}, {"cube_mm", cube_voxels * c.roles.geometry.spacing_mm.maxCoeff()},
+              {"nodes", c.mesh.node_count()}, {"tetrahedra", c.mesh.tets.size()}};
+  try {
+    SolveResult r;
+    with_threads(0, [&] { r = solve(c.mesh, opt); });
+    const DeformationMetrics d = deformation_metrics(c.mesh, r.x);
+    row["wall_s"] = seconds_since(t0);
+    row["converged"] = r.converged;
+    row["stop_reason"] = r.stop_reason;
+    row["steps"] = r.steps;
+    row["inner_iterations"] = r.inner_iterations;
+    row["inverted_tetrahedra"] = r.inverted_tetrahedra;
+    row["anterior_rise_mm"] = d.anterior_rise_mm;
+    row["cavity_volume_ml"] = d.cavity_volume_ml;
+  } catch (const TimeLimit&) {
+    row["wall_s"] = seconds_since(t0);
+    row["converged"] = false;
+    row["stop_reason"] = "time limit of the benchmark (" + std::to_string(int(limit_s)) + " s)";
+  }
+  return row;
+}
+
+json measure_real_ct(BenchContext& ctx, const std::string& springs_scene, const std::string& fem_scene) {
+  if (ctx.quick()) {
+    ctx.note("material_models: --quick leaves out the real CT");
+    return json::array();
+  }
+  std::string why;
+  std::optional<BenchCase> springs = scene_case(springs_scene, "real_ct", why);
+  std::optional<BenchCase> fem = springs ? scene_case(fem_scene, "real_ct_fem", why) : std::nullopt;
+  if (!springs || !fem) {
+    ctx.note("material_models: real CT skipped: " + why);
+    return json::array();
+  }
+  constexpr double kLimitS = 300;
+  json rows = json::array();
+  const double spacing = springs->roles.geometry.spacing_mm.maxCoeff();
+  for (const ScenePreset p : {ScenePreset::Preview, ScenePreset::Balanced, ScenePreset::Accurate}) {
+    const int L = std::max(1, int(std::lround(preset_settings(p).cube_mm / spacing)));
+    struct Run {
+      BenchCase* c;
+      SolverMethod method;
+    };
+    for (const Run run : {Run{&*springs, SolverMethod::Static}, Run{&*fem, SolverMethod::Newton},
+                          Run{&*fem, SolverMethod::Static}}) {
+      std::fprintf(stderr, "[bench] models: real CT, %s, %s, L = %d\n", enum_name(run.c->scene.material.model),
+                   enum_name(run.method), L);
+      json row = real_ct_row(*run.c, L, run.method, kLimitS);
+      row["preset"] = enum_name(p);
+      rows.push_back(row);
+    }
+  }
+  return rows;
+}
+
+// Bytes each tetrahedron's kernels read and write once per call (fem_forces.cl), counted once: states (4 node
+// displacements, its nodes, D_m⁻¹, constants; the state out), forces (state, D_m⁻¹, constants, group and ē; 4
+// forces out), the group average (weight and e) and the gather (4 force entries and their indices). The
+// product: δF (direction, nodes, D_m⁻¹, the rotation; δF out), the group average, the forces' change (state,
+// D_m⁻¹, constants, ē, δē, δF; 4 forces out) and the gather.
+constexpr double kEvaluateBytesPerTet = (64 + 16 + 36 + 16 + 160) + (160 + 36 + 16 + 8 + 64) + 8 + (64 + 16);
+constexpr double kProductBytesPerTet = (64 + 16 + 36 + 36 + 40) + 8 + (160 + 36 + 16 + 8 + 40 + 64) + (64 + 16);
+
+json measure_throughput(BenchContext& ctx) {
+  BenchCase c = phantom_case(PhantomSize::Small, ctx.quick() ? 4 : 0);
+  c.scene.material.model = MaterialModel::FemNeoHookean;
+  c.scene.material.stiffening = 10.0;
+  remesh(c, c.mesh.cube_voxels);
+  ForceModel model = solve_options_from_scene(c.scene).forces;
+  model.damping = false;
+  const double T = double(c.mesh.tets.size());
+  std::vector<Vec3> dir(c.mesh.node_count(), Vec3(1e-4, -2e-4, 3e-4)), f, kp;
+  const int reps = ctx.quick() ? 3 : 10;
+  json rows = json::array();
+  for (const Device& d : ctx.devices()) {
+    std::unique_ptr<ForceField> field =
+        d.opencl() ? make_fem_force_field_cl(ctx.cl(d), c.mesh, model.material) : make_force_field(c.mesh, model);
+    Summary eval, product;
+    // Each evaluation at a new state (states are cached per position): alternate two.
+    std::vector<Vec3> a = c.mesh.rest_m, b = c.mesh.rest_m;
+    for (auto& x : b) x *= 1.001;
+    bool flip = false;
+    with_threads(d.threads, [&] {
+      eval = time_reps(reps, 1, [&] {
+        field->evaluate(model, flip ? a : b, {}, f);
+        flip = !flip;
+      });
+      field->linearize(model, b);
+      product = time_reps(reps, 1, [&] { field->stiffness_product(dir, kp); });
+    });
+    json row = {{"device", d.name}, {"description", d.description()}, {"tetrahedra", T},
+                {"evaluate_s", to_json(eval)}, {"product_s", to_json(product)},
+                {"evaluate_element_updates_per_s", T / eval.median},
+                {"product_element_updates_per_s", T / product.median}};
+    if (d.opencl()) {
+      const double triad = ctx.bandwidth_gb_s(d);
+      row["bytes_per_tet_evaluate"] = kEvaluateBytesPerTet;
+      row["bytes_per_tet_product"] = kProductBytesPerTet;
+      row["evaluate_fraction_of_triad"] = kEvaluateBytesPerTet * T / eval.median / (triad * 1e9);
+      row["product_fraction_of_triad"] = kProductBytesPerTet * T / product.median / (triad * 1e9);
+    } else {
+      row["roofline"] = "the CPU reference works in double on its own element states: its bytes are not the "
+                        "kernels'; compare its updates per second only";
+    }
+    rows.push_back(row);
+  }
+  return {{"case", c.name}, {"model", "fem-neohookean, b = 10, nu " + std::to_string(c.scene.material.poisson_ratio)},
+          {"nodes", c.mesh.node_count()}, {"rows", rows},
+          {"peer", {{"source", "SofaCUDA TetrahedronFEM as published (issue \"Bano's row\"): 2.6 ms per implicit "
+                               "Euler step at 19 k nodes on an RTX 2070"},
+                    {"nodes", 19000}, {"ms_per_step", 2.6},
+                    {"comparable", "not directly: a step there holds its CG iterations (each a product like "
+                                   "product_s here) and one evaluation; the peer is the order of magnitude a GPU "
+                                   "reaches, not a ratio"}}}};
+}
+
+// The rule: for each preset's cube size, among the models whose real-CT solve converged without inverted
+// tetrahedra, preview takes the fastest; balanced the fastest whose Lamé error (inner and outer, the finest cube
+// measured) is within 5 %; accurate the one with the smallest such error. The error is the model's at the ν
+// its scene uses (0.45 for the elements, 1/4 for the springs).
+json choose(const json& lame, const json& real_ct) {
+  auto lame_error = [&](const std::string& model) {
+    double best_cube = std::numeric_limits<double>::infinity(), err = std::numeric_limits<double>::infinity();
+    for (const auto& r : lame)
+      if (r["model"] == model && r["device"] == "cpu" &&
+          (model == "msd" || std::abs(r["poisson_ratio"].get<double>() - 0.45) < 1e-9) &&
+          r["cube_mm"].get<double>() < best_cube) {
+        best_cube = r["cube_mm"];
+        err = std::max(std::abs(r["rel_error_inner"].get<double>()), std::abs(r["rel_error_outer"].get<double>()));
+      }
+    return err;
+  };
+  json out = json::array();
+  for (const char* preset : {"preview", "balanced", "accurate"}) {
+    const json* pick = nullptr;
+    double pick_key = std::numeric_limits<double>::infinity();
+    for (const auto& r : real_ct) {
+      if (r["preset"] != preset || !r["converged"].get<bool>() || r["inverted_tetrahedra"].get<int64_t>() != 0) continue;
+      const double err = lame_error(r["model"]), t = r["wall_s"];
+      const std::string p = preset;
+      const double key = p == "preview" ? t : p == "balanced" ? (err <= 0.05 ? t : INFINITY) : err + 1e-6 * t;
+      if (key < pick_key) { pick_key = key; pick = &r; }
+    }
+    const ScenePreset sp = std::string(preset) == "preview" ? ScenePreset::Preview
+                           : std::string(preset) == "balanced" ? ScenePreset::Balanced : ScenePreset::Accurate;
+    json j = {{"preset", preset}, {"preset_solver", enum_name(preset_settings(sp).method)},
+              {"preset_model", "msd (the scene's material.model: presets set the solver and cube only)"}};
+    j["chosen"] = pick ? json{{"model", (*pick)["model"]}, {"solver", (*pick)["solver"]}, {"wall_s", (*pick)["wall_s"]},
+                              {"lame_error", lame_error((*pick)["model"])}}
+                       : json(nullptr);
+    out.push_back(j);
+  }
+  return out;
+}
+
+}  // namespace
+
+json measure_material_models(BenchContext& ctx, const std::string& springs_scene, const std::string& fem_scene) {
+  json out;
+  out["lame"] = measure_lame(ctx);
+  out["real_ct"] = measure_real_ct(ctx, springs_scene, fem_scene);
+  out["throughput"] = measure_throughput(ctx);
+  out["choice_rule"] =
+      "per preset cube size, among models whose real-CT solve converged with 0 inverted tetrahedra: preview the "
+      "fastest; balanced the fastest whose Lame error (max of inner and outer, finest cube measured, the scene's nu) "
+      "is within 5 %; accurate the smallest such error";
+  out["choice"] = choose(out["lame"], out["real_ct"]);
+  return out;
+}
+
+}  // namespace pneumo::bench
