@@ -21,87 +21,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "solve/conjugate_gradients.h"
 #include "solve/force_field.h"
 #include "solve/pressure_stiffness.h"
 #include "solve/solver_common.h"
 
 namespace pneumo {
-
-namespace {
-
-double dot(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
-  double s = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) s += a[i].dot(b[i]);
-  return s;
-}
-
-// The inverse of each node's diagonal block on its free axes (held axes: zero rows and columns).
-std::vector<Mat3> block_jacobi(const Mesh& m, const std::vector<Mat3>& blocks) {
-  std::vector<Mat3> inv(blocks.size());
-  for (std::size_t n = 0; n < blocks.size(); ++n) {
-    Mat3 b = blocks[n];
-    for (int a = 0; a < 3; ++a)
-      if (m.hold[n] & (1 << a)) { b.row(a).setZero(); b.col(a).setZero(); b(a, a) = 1.0; }
-    Mat3 i;
-    bool ok = false;
-    double det = 0.0;
-    b.computeInverseAndDetWithCheck(i, det, ok);
-    // A block that is not positive (a node of compressed springs only) falls back to its diagonal.
-    if (!ok || !(det > 0.0) || !i.allFinite()) {
-      i.setZero();
-      for (int a = 0; a < 3; ++a) i(a, a) = b(a, a) > 0.0 ? 1.0 / b(a, a) : 0.0;
-    }
-    for (int a = 0; a < 3; ++a)
-      if (m.hold[n] & (1 << a)) { i.row(a).setZero(); i.col(a).setZero(); }
-    inv[n] = i;
-  }
-  return inv;
-}
-
-struct CgOutcome {
-  int iterations = 0;
-  bool negative_curvature = false;
-};
-
-// Solves (K + σ D) d = f to |f − (K + σ D) d| ≤ η |f| on the free axes, D the diagonal blocks of K
-// (`blocks`, used only when σ > 0).
-CgOutcome conjugate_gradients(const Mesh& m, ForceField& field, const PressureStiffness& pressure,
-                              const std::vector<Mat3>& precond,
-                              const std::vector<Mat3>& blocks, double sigma, const std::vector<Vec3>& f,
-                              double eta, int max_iterations, std::vector<Vec3>& d) {
-  const std::size_t N = f.size();
-  CgOutcome out;
-  std::vector<Vec3> r = f, z(N), p(N), kp;
-  d.assign(N, Vec3::Zero());
-  for (std::size_t n = 0; n < N; ++n) z[n] = precond[n] * r[n];
-  p = z;
-  double rz = dot(r, z);
-  const double stop = eta * std::sqrt(dot(f, f));
-  for (int it = 0; it < max_iterations; ++it) {
-    field.stiffness_product(p, kp);
-    pressure.add_product(p, kp);
-    if (sigma > 0.0)
-      for (std::size_t n = 0; n < N; ++n) kp[n] += sigma * (blocks[n] * p[n]);
-    detail::apply_holds(m, kp);
-    const double pkp = dot(p, kp);
-    if (!(pkp > 0.0)) {
-      out.negative_curvature = true;
-      break;
-    }
-    const double a = rz / pkp;
-    for (std::size_t n = 0; n < N; ++n) { d[n] += a * p[n]; r[n] -= a * kp[n]; }
-    out.iterations = it + 1;
-    if (std::sqrt(dot(r, r)) <= stop) break;
-    for (std::size_t n = 0; n < N; ++n) z[n] = precond[n] * r[n];
-    const double rz_next = dot(r, z);
-    const double beta = rz_next / rz;
-    rz = rz_next;
-    for (std::size_t n = 0; n < N; ++n) p[n] = z[n] + beta * p[n];
-  }
-  return out;
-}
-
-}  // namespace
 
 SolveResult solve_newton(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x) {
   const std::unique_ptr<ForceField> field = make_force_field(m, opt.forces);
@@ -149,7 +74,13 @@ SolveResult solve_newton_on(const Mesh& m, const SolveOptions& opt, ForceField& 
       // At negative curvature: the shifted system K + σ D (above).
       CgOutcome cg;
       for (;;) {
-        cg = conjugate_gradients(m, field, pressure, precond, blocks, shift, f, eta, opt.newton_max_cg_iterations, d);
+        const LinearOperator K = [&](const std::vector<Vec3>& p, std::vector<Vec3>& kp) {
+          field.stiffness_product(p, kp);
+          pressure.add_product(p, kp);
+          if (shift > 0.0)
+            for (int64_t n = 0; n < N; ++n) kp[n] += shift * (blocks[n] * p[n]);
+        };
+        cg = conjugate_gradients(m, K, precond, f, eta, opt.newton_max_cg_iterations, d);
         cg_iterations += cg.iterations;
         if (!cg.negative_curvature) break;
         shift = shift > 0.0 ? 10.0 * shift : kFirstShift;
