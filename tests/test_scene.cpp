@@ -447,9 +447,12 @@ TEST(SceneRules, PortTargetsAndPathKeyframes) {
 TEST(SceneRules, FiniteElementsNeedAStaticSolverAndRefuseTheSpringsOwnKeys) {
   // Each rule of check_material_model, with the message a user reads.
   EXPECT_NO_THROW(parse_scene({{"material", {{"model", "fem-corotational"}}}}, kOrigin));   // the static solver
+  EXPECT_NO_THROW(parse_scene({{"material", {{"model", "fem-corotational"}}}, {"solver", {{"method", "implicit-euler"}}}},
+                              kOrigin));
   const json fem = {{"material", {{"model", "fem-corotational"}}}, {"solver", {{"method", "explicit"}}}};
   EXPECT_CONTAINS(error_of(fem),
-                  "solver.method = \"explicit\" cannot solve material.model \"fem-corotational\"; use \"newton\" or \"static\"");
+                  "solver.method = \"explicit\" cannot solve material.model \"fem-corotational\"; use \"newton\", "
+                  "\"static\" or \"implicit-euler\"");
   json j = {{"material", {{"model", "fem-corotational"}, {"stiffening", 5}}}, {"solver", {{"method", "newton"}}}};
   EXPECT_CONTAINS(error_of(j), "material.stiffening = 5");
   j = {{"material", {{"model", "fem-neohookean"}, {"volume_stiffness_kpa", 60}}}, {"solver", {{"method", "newton"}}}};
@@ -563,7 +566,8 @@ TEST(SceneReference, ListsEveryKey) {
                               "## `render.paths[].keyframes[]` (each item)", "## `material.label_young_kpa[]` (each item)"})
     EXPECT_CONTAINS(md, heading);
   for (const char* row : {"| `pressure_mmhg` | number | `12.0` | 0 to 100 | mmHg |", "| `fov_deg` | number | `70.0` |",
-                          "| `method` | enum | `\"static\"` | \"static\", \"explicit\", \"newmark\", \"kitasaka2004\", \"newton\" |"})
+                          "| `method` | enum | `\"static\"` | \"static\", \"explicit\", \"newmark\", \"kitasaka2004\", \"newton\", "
+                          "\"implicit-euler\" |"})
     EXPECT_CONTAINS(md, row);
 }
 

@@ -29,7 +29,7 @@ enum class SpringModel : uint8_t { Nonlinear, Linear };
 /// The material model on the tetrahedra: the springs of §4–5 or finite elements (solve/fem_element.h).
 enum class MaterialModel : uint8_t { Msd, FemCorotational, FemNeoHookean };
 enum class RampShape : uint8_t { Smooth, Linear };
-enum class SolverMethod : uint8_t { Static, Explicit, Newmark, Kitasaka2004, Newton };
+enum class SolverMethod : uint8_t { Static, Explicit, Newmark, Kitasaka2004, Newton, ImplicitEuler };
 enum class OnInverted : uint8_t { Continue, Stop };
 enum class Lens : uint8_t { Pinhole, Fisheye };
 enum class RenderPreset : uint8_t { Laparoscopic, CtSoftTissue, CtMuscle, CtAaa, CtAir, Custom };
@@ -61,7 +61,8 @@ template <> struct EnumNames<RampShape> {
   static constexpr std::array<const char*, 2> names{"smooth", "linear"};
 };
 template <> struct EnumNames<SolverMethod> {
-  static constexpr std::array<const char*, 5> names{"static", "explicit", "newmark", "kitasaka2004", "newton"};
+  static constexpr std::array<const char*, 6> names{"static", "explicit", "newmark", "kitasaka2004", "newton",
+                                                      "implicit-euler"};
 };
 template <> struct EnumNames<OnInverted> {
   static constexpr std::array<const char*, 2> names{"continue", "stop"};
@@ -176,6 +177,8 @@ struct SceneSolver {
   OnInverted on_inverted = OnInverted::Continue;
   int64_t checkpoint_every_steps = 0;    // 0 = off
   int newton_max_cg_iterations = 500;    // conjugate-gradient iterations per Newton step
+  double rayleigh_mass_per_s = 0.1;      // implicit-euler: C = α M + β K (SOFA's former defaults)
+  double rayleigh_stiffness_s = 0.1;
 };
 
 /// Optics shared by cameras, ports and paths (§8).

@@ -169,7 +169,7 @@ const Table<SceneMaterial>& material_table() {
       {"model", &SceneMaterial::model, "", any(),
        "\"msd\": the mass-spring lattice (§4-5); \"fem-corotational\": co-rotational linear tetrahedra (as SOFA, "
        "Bano 2012); \"fem-neohookean\": neo-Hookean tetrahedra, with Demiray's stiffening when stiffening > 0. The "
-       "FEM models need solver.method \"newton\" (the fast choice) or \"static\" (docs/fem.md)."},
+       "FEM models need solver.method \"newton\" (the fast choice), \"static\" or \"implicit-euler\" (docs/fem.md)."},
       {"poisson_ratio", &SceneMaterial::poisson_ratio, "", in(0, 0.49),
        "ν of the finite elements unless overridden (Bano 2012: 0.49 for the wall); the springs' ν is 1/4."},
       {"wall_poisson_ratio", &SceneMaterial::wall_poisson_ratio, "", in(0, 0.49),
@@ -214,8 +214,9 @@ const Table<SceneSolver>& solver_table() {
       {"method", &SceneSolver::method, "", any(),
        "\"static\": fast equilibrium; \"explicit\": symplectic Euler; \"newmark\": Nimura's Newmark-β; "
        "\"kitasaka2004\": Kitasaka's quasi-static scheme (§6); \"newton\": Newton with preconditioned conjugate "
-       "gradients (static; every material model; on OpenCL for the finite elements). The finite elements "
-       "take \"static\" or \"newton\"."},
+       "gradients (static; every material model; on OpenCL for the finite elements); \"implicit-euler\": "
+       "backward Euler with conjugate gradients and Rayleigh damping (dynamic, as Bano 2012 with SOFA; every "
+       "material model; CPU). The finite elements take \"static\", \"newton\" or \"implicit-euler\"."},
       {"dt_ms", &SceneSolver::dt_ms, "ms", in(0, 1000),
        "Time step of explicit and newmark; 0 = dt_safety × the stability bound (§6)."},
       {"dt_safety", &SceneSolver::dt_safety, "", above(0, 1), "Fraction of the stability bound used when dt_ms = 0."},
@@ -241,7 +242,12 @@ const Table<SceneSolver>& solver_table() {
       {"checkpoint_every_steps", &SceneSolver::checkpoint_every_steps, "", in(0, 1e9),
        "Save the node state every this many steps, to resume a long run; 0 = never."},
       {"newton_max_cg_iterations", &SceneSolver::newton_max_cg_iterations, "", in(1, 100000),
-       "newton: conjugate-gradient iterations allowed per Newton step (the step keeps what it reached)."},
+       "newton: conjugate-gradient iterations allowed per Newton step (the step keeps what it reached); "
+       "implicit-euler: per time step."},
+      {"rayleigh_mass_per_s", &SceneSolver::rayleigh_mass_per_s, "1/s", in(0, 1000),
+       "implicit-euler: α of Rayleigh's damping C = α M + β K (SOFA's EulerImplicitSolver; 0.1 its former default)."},
+      {"rayleigh_stiffness_s", &SceneSolver::rayleigh_stiffness_s, "s", in(0, 10),
+       "implicit-euler: β of Rayleigh's damping C = α M + β K (0.1 SOFA's former default)."},
   };
   return t;
 }

@@ -59,12 +59,13 @@ void check_label_young(const SceneMaterial& m, const At& material) {
 void check_material_model(const Scene& s, const At& root) {
   const SceneMaterial& m = s.material;
   if (m.model == MaterialModel::Msd) return;
-  // The dynamic schemes need the springs' dampers and stable step, the 2004 scheme their stiffness
-  // sums; the finite elements have neither (docs/fem.md).
-  if (s.solver.method != SolverMethod::Newton && s.solver.method != SolverMethod::Static)
+  // The explicit schemes need the springs' dampers and stable step, the 2004 scheme their stiffness
+  // sums; the finite elements have neither (docs/fem.md). Implicit Euler damps by Rayleigh's C.
+  if (s.solver.method != SolverMethod::Newton && s.solver.method != SolverMethod::Static &&
+      s.solver.method != SolverMethod::ImplicitEuler)
     root.child("solver").child("method").fail_value(enum_name(s.solver.method),
                                                     std::string("cannot solve material.model \"") + enum_name(m.model) +
-                                                        "\"; use \"newton\" or \"static\"");
+                                                        "\"; use \"newton\", \"static\" or \"implicit-euler\"");
   if (m.model == MaterialModel::FemCorotational && m.stiffening > 0.0)
     root.child("material").child("stiffening").fail_value(m.stiffening,
                                                           "has no meaning for \"fem-corotational\" (a linear law); "

@@ -11,6 +11,7 @@ namespace pneumo {
 
 bool device_implements(const SolveOptions& opt) {
   const bool fem = opt.forces.material != MaterialModel::Msd;
+  if (opt.method == SolverMethod::ImplicitEuler) return false;
   return opt.method == SolverMethod::Newton ? fem : !fem;
 }
 

@@ -13,6 +13,7 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
 SolveResult solve_kitasaka2004(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x);
 SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x);
 SolveResult solve_newton(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x);
+SolveResult solve_implicit_euler(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x);
 
 double stable_time_step(const Mesh& m, bool damping) {
   std::vector<double> ksum(m.node_count(), 0.0), csum(m.node_count(), 0.0);
@@ -60,6 +61,8 @@ SolveOptions solve_options_from_scene(const Scene& s) {
   o.newmark_inner_tolerance = s.solver.newmark_inner_tolerance;
   o.newmark_max_inner = s.solver.newmark_max_inner;
   o.newton_max_cg_iterations = s.solver.newton_max_cg_iterations;
+  o.rayleigh_mass_per_s = s.solver.rayleigh_mass_per_s;
+  o.rayleigh_stiffness_s = s.solver.rayleigh_stiffness_s;
   o.kitasaka_step = s.solver.kitasaka_step;
   o.kitasaka_tolerance_m = s.solver.kitasaka_tolerance_mm * units::kMetresPerMm;
   o.on_inverted = s.solver.on_inverted;
@@ -74,6 +77,7 @@ SolveResult solve(const Mesh& m, const SolveOptions& opt, const std::vector<Vec3
     case SolverMethod::Kitasaka2004: return solve_kitasaka2004(m, opt, std::move(x));
     case SolverMethod::Static: return solve_static_fire(m, opt, std::move(x));
     case SolverMethod::Newton: return solve_newton(m, opt, std::move(x));
+    case SolverMethod::ImplicitEuler: return solve_implicit_euler(m, opt, std::move(x));
   }
   throw std::logic_error("unknown solver");
 }

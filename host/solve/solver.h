@@ -39,6 +39,7 @@ struct SolveOptions {
   double newmark_inner_tolerance = 1e-6;
   int newmark_max_inner = 50;
   int newton_max_cg_iterations = 500;
+  double rayleigh_mass_per_s = 0.1, rayleigh_stiffness_s = 0.1;   // implicit Euler: C = α M + β K
   double kitasaka_step = 0.3;
   double kitasaka_tolerance_m = 1e-3;  // β: Σ|ΔR_i| over all nodes
   bool kitasaka_jacobi = false;        // CPU reference: all nodes from the same forces, as the device does

@@ -321,7 +321,9 @@ SolveResult solve_opencl(ocl::Context& ctx, const Mesh& m, const SolveOptions& o
     case SolverMethod::Kitasaka2004: return kitasaka_cl(ctx, m, opt, x0);
     case SolverMethod::Static: return static_fire_cl(ctx, m, opt, x0);
     case SolverMethod::Newton:
-      throw std::logic_error("solve_opencl: newton has no device implementation; solve through solve_on_device()");
+    case SolverMethod::ImplicitEuler:
+      throw std::logic_error(std::string("solve_opencl: ") + enum_name(opt.method) +
+                             " has no device implementation of its own; solve through solve_on_device()");
   }
   throw std::logic_error("unknown solver");
 }
