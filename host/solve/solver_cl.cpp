@@ -339,8 +339,8 @@ struct ClExplicitStepper::Impl {
 };
 
 ClExplicitStepper::ClExplicitStepper(ocl::Context& ctx, const Mesh& m, const ForceModel& model, double dt_s)
-    : impl_(new Impl(ctx, m, model, dt_s)) {}
-ClExplicitStepper::~ClExplicitStepper() { delete impl_; }
+    : impl_(std::make_unique<Impl>(ctx, m, model, dt_s)) {}
+ClExplicitStepper::~ClExplicitStepper() = default;   // here, where Impl is complete
 void ClExplicitStepper::steps(int n) {
   for (int i = 0; i < n; ++i) {
     impl_->d.eval.evaluate(impl_->model, ClForceEvaluator::Nodes::Free);

@@ -6,6 +6,7 @@
 // (Jacobi) on the device, where the CPU reference goes node by node (Gauss–Seidel), as method.md §6
 // says; both stop at the same tolerance, so they reach the same equilibrium.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "cl/cl_runtime.h"
@@ -26,11 +27,13 @@ class ClExplicitStepper {
  public:
   ClExplicitStepper(ocl::Context& ctx, const Mesh& m, const ForceModel& model, double dt_s);
   ~ClExplicitStepper();
+  ClExplicitStepper(const ClExplicitStepper&) = delete;
+  ClExplicitStepper& operator=(const ClExplicitStepper&) = delete;
   void steps(int n);   // enqueues n steps (force evaluation + update each)
   void finish();       // waits for the device
  private:
   struct Impl;
-  Impl* impl_;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace pneumo
