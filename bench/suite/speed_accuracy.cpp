@@ -34,6 +34,7 @@ const char* setting_name(SolverMethod m) {
   switch (m) {
     case SolverMethod::Static:
     case SolverMethod::Newton: return "residual_tolerance";
+    case SolverMethod::ImplicitEuler: return "dt_ms";
     case SolverMethod::Explicit:
     case SolverMethod::Newmark: return "dt_safety";
     case SolverMethod::Kitasaka2004: return "kitasaka_tolerance_mm_per_node";
