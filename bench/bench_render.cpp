@@ -25,6 +25,7 @@
 #include "render/image_out.h"
 #include "render/ray_cast_gl.h"
 #include "render/ray_cast_ref.h"
+#include "scene/scene.h"
 
 using namespace pneumo;
 

@@ -45,6 +45,7 @@
 #include "perf/bandwidth.h"
 #include "phantom/phantom.h"
 #include "roles/roles.h"
+#include "scene/scene.h"
 #include "solve/solver.h"
 #include "warp/warp.h"
 

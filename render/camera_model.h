@@ -18,7 +18,7 @@
 #include <optional>
 
 #include "core/geometry.h"
-#include "scene/scene.h"
+#include "scene/scene_types.h"
 
 namespace pneumo {
 

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "scene/scene.h"
 
 namespace pneumo {
 

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "render/camera_model.h"
-#include "scene/scene.h"
+#include "scene/scene_types.h"
 
 namespace pneumo {
 

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "scene/scene.h"
 
 namespace pneumo {
 namespace {

@@ -8,7 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "scene/scene.h"
+#include "core/geometry.h"
+#include "scene/scene_types.h"
 
 namespace pneumo {
 

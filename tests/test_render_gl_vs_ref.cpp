@@ -19,6 +19,7 @@
 #include "render/ray_cast_gl.h"
 #include "render/ray_cast_ref.h"
 #include "render_test_support.h"
+#include "scene/scene.h"
 
 namespace pneumo {
 namespace {

@@ -11,6 +11,7 @@
 #include "render/poses.h"
 #include "render/ray_cast_ref.h"
 #include "render_test_support.h"
+#include "scene/scene.h"
 
 namespace pneumo {
 namespace {

@@ -14,6 +14,7 @@
 #include "report/slices.h"
 #include "roles/pad.h"
 #include "roles/roles.h"
+#include "scene/scene.h"
 
 using namespace pneumo;
 using testing_support::ScratchDir;

@@ -14,6 +14,7 @@
 #include "core/progress.h"
 #include "phantom/phantom.h"
 #include "roles/roles.h"
+#include "scene/scene.h"
 
 using namespace pneumo;
 

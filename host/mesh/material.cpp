@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "mesh/mesh.h"
+#include "scene/scene.h"
 #include "scene/scene_presets.h"
 
 namespace pneumo {

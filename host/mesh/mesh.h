@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "scene/scene.h"
+#include "scene/scene_types.h"
 
 namespace pneumo {
 

@@ -12,6 +12,7 @@
 #include "roles/distance_transform.h"
 #include "roles/label_map.h"
 #include "roles/lateral_to_bone.h"
+#include "scene/scene.h"
 
 namespace pneumo {
 

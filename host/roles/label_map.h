@@ -7,7 +7,7 @@
 
 #include "core/geometry.h"
 #include "io/volume.h"
-#include "scene/scene.h"
+#include "scene/scene_types.h"
 
 namespace pneumo {
 

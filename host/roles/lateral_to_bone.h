@@ -8,7 +8,7 @@
 
 #include "roles/anatomical_axes.h"
 #include "roles/body_mask.h"
-#include "scene/scene.h"
+#include "scene/scene_types.h"
 
 namespace pneumo {
 

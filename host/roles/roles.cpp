@@ -8,6 +8,7 @@
 #include "io/volume_io.h"
 #include "roles/auto_roles.h"
 #include "roles/label_map.h"
+#include "scene/scene.h"
 
 namespace pneumo {
 

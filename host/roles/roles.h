@@ -9,7 +9,7 @@
 #include "core/geometry.h"
 #include "io/volume.h"
 #include "roles/pad.h"
-#include "scene/scene.h"
+#include "scene/scene_types.h"
 
 namespace pneumo {
 

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/units.h"
+#include "scene/scene.h"
 #include "solve/solver_common.h"
 
 namespace pneumo {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "mesh/mesh.h"
-#include "scene/scene.h"
+#include "scene/scene_types.h"
 #include "solve/forces.h"
 
 namespace pneumo {

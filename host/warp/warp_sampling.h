@@ -15,7 +15,7 @@
 #endif
 
 #include "core/geometry.h"
-#include "scene/scene.h"
+#include "scene/scene_types.h"
 
 namespace pneumo {
 

@@ -1,0 +1,88 @@
+#pragma once
+// The scene's named values and the names of its sections, without the sections themselves: what the
+// stage headers (roles, mesh, solve, warp, render) need, so that they do not depend on the whole scene
+// type (scene.h defines the sections; issue "One shape for every stage").
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+namespace pneumo {
+
+// ---- named values ------------------------------------------------------------------------------
+
+/// What a voxel is in the simulation (§2).
+enum class Role : uint8_t { Other = 0, Wall = 1, Viscera = 2, Fixed = 3 };
+enum class RoleSource : uint8_t { Labels, Auto };
+enum class MeshModel : uint8_t { WallViscera, Wall };
+enum class SpringModel : uint8_t { Nonlinear, Linear };
+/// The material model on the tetrahedra: the springs of §4–5 or finite elements (solve/fem_element.h).
+enum class MaterialModel : uint8_t { Msd, FemCorotational, FemNeoHookean };
+enum class RampShape : uint8_t { Smooth, Linear };
+enum class SolverMethod : uint8_t { Static, Explicit, Newmark, Kitasaka2004, Newton, ImplicitEuler };
+enum class OnInverted : uint8_t { Continue, Stop };
+enum class Lens : uint8_t { Pinhole, Fisheye };
+enum class RenderPreset : uint8_t { Laparoscopic, CtSoftTissue, CtMuscle, CtAaa, CtAir, Custom };
+/// Speed against accuracy (scene_presets.h): what `pneumo bench` measured each to buy.
+enum class ScenePreset : uint8_t { None, Preview, Balanced, Accurate };
+/// The grid of the deformed CT and labels: the working grid (the CT with the roles' padding, which
+/// holds the mesh and so the risen dome) or the input CT's own.
+enum class OutputGrid : uint8_t { Working, Input };
+
+/// How each enum's values are written in scene files, indexed by the value: the one place these
+/// names are spelled (the parser, the reference and enum_name() all read them from here).
+template <class E> struct EnumNames;
+template <> struct EnumNames<Role> {
+  static constexpr std::array<const char*, 4> names{"other", "wall", "viscera", "fixed"};
+};
+template <> struct EnumNames<RoleSource> {
+  static constexpr std::array<const char*, 2> names{"labels", "auto"};
+};
+template <> struct EnumNames<MeshModel> {
+  static constexpr std::array<const char*, 2> names{"wall_viscera", "wall"};
+};
+template <> struct EnumNames<SpringModel> {
+  static constexpr std::array<const char*, 2> names{"nonlinear", "linear"};
+};
+template <> struct EnumNames<MaterialModel> {
+  static constexpr std::array<const char*, 3> names{"msd", "fem-corotational", "fem-neohookean"};
+};
+template <> struct EnumNames<RampShape> {
+  static constexpr std::array<const char*, 2> names{"smooth", "linear"};
+};
+template <> struct EnumNames<SolverMethod> {
+  static constexpr std::array<const char*, 6> names{"static", "explicit", "newmark", "kitasaka2004", "newton",
+                                                      "implicit-euler"};
+};
+template <> struct EnumNames<OnInverted> {
+  static constexpr std::array<const char*, 2> names{"continue", "stop"};
+};
+template <> struct EnumNames<Lens> {
+  static constexpr std::array<const char*, 2> names{"pinhole", "fisheye"};
+};
+template <> struct EnumNames<RenderPreset> {
+  static constexpr std::array<const char*, 6> names{"laparoscopic", "ct-soft-tissue", "ct-muscle",
+                                                    "ct-aaa", "ct-air", "custom"};
+};
+
+template <> struct EnumNames<OutputGrid> {
+  static constexpr std::array<const char*, 2> names{"working", "input"};
+};
+template <> struct EnumNames<ScenePreset> {
+  static constexpr std::array<const char*, 4> names{"none", "preview", "balanced", "accurate"};
+};
+
+/// The scene-file name of an enum value ("kitasaka2004", "ct-muscle", ...).
+template <class E> const char* enum_name(E e) {
+  return EnumNames<E>::names[static_cast<std::size_t>(e)];
+}
+inline const char* role_name(Role r) { return enum_name(r); }
+
+// ---- sections, declared (scene.h defines them) ---------------------------------------------------
+
+struct Scene;
+struct SceneRoles;
+struct SceneRender;
+struct Optics;
+struct Keyframe;
+
+}  // namespace pneumo
