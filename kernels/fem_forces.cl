@@ -12,18 +12,20 @@
 // below). Per group of the mean dilatation: [begin, end) in the group's list of tetrahedra and
 // 1/Σ κ_t V_t. Per node: compressed rows of (tetrahedron × 8 + vertex), as host/mesh/adjacency.h.
 
-#define kStateFloats 40
 // State offsets: F (9), A (9: R, or F⁻ᵀ), B (9: the co-rotational (tr S·I − S)⁻¹), then e, J^{−2/3},
-// I₁, e^{b(Ī₁−3)}, valid, and the deviatoric energy density.
+// I₁, e^{b(Ī₁−3)}, valid, and the deviatoric energy density. The stride and the two offsets the host
+// reads (e for the group average, ψ for the energy) come from the host as build options
+// (fem_force_field_cl.cpp), so the layout is written once on each side of what they share.
+#if !defined(kStateFloats) || !defined(S_E) || !defined(S_PSI)
+#error "fem_forces.cl needs -DkStateFloats, -DS_E and -DS_PSI (fem_force_field_cl.cpp)"
+#endif
 #define S_F 0
 #define S_A 9
 #define S_B 18
-#define S_E 27
-#define S_J23 28
-#define S_I1 29
-#define S_EXP 30
-#define S_VALID 31
-#define S_PSI 32
+#define S_J23 (S_E + 1)
+#define S_I1 (S_E + 2)
+#define S_EXP (S_E + 3)
+#define S_VALID (S_E + 4)
 
 typedef struct { float m[9]; } mat3;   // row-major
 

@@ -64,4 +64,24 @@ CgOutcome conjugate_gradients(const Mesh& m, const LinearOperator& A, const std:
   return out;
 }
 
+CgOutcome shifted_conjugate_gradients(const Mesh& m, const LinearOperator& A, const std::vector<Mat3>& blocks,
+                                      const std::vector<Mat3>& precond, const std::vector<Vec3>& b, double eta,
+                                      int max_iterations, Shift& shift, std::vector<Vec3>& d) {
+  const LinearOperator shifted = [&](const std::vector<Vec3>& p, std::vector<Vec3>& y) {
+    A(p, y);
+    if (shift.sigma > 0.0)
+      for (std::size_t n = 0; n < p.size(); ++n) y[n] += shift.sigma * (blocks[n] * p[n]);
+  };
+  int iterations = 0;
+  for (;;) {
+    CgOutcome cg = conjugate_gradients(m, shifted, precond, b, eta, max_iterations, d);
+    iterations += cg.iterations;
+    if (!cg.negative_curvature || shift.sigma >= Shift::kMax) {
+      cg.iterations = iterations;
+      return cg;
+    }
+    shift.sigma = shift.sigma > 0.0 ? 10.0 * shift.sigma : Shift::kFirst;
+  }
+}
+
 }  // namespace pneumo

@@ -27,4 +27,19 @@ using LinearOperator = std::function<void(const std::vector<Vec3>& p, std::vecto
 CgOutcome conjugate_gradients(const Mesh& m, const LinearOperator& A, const std::vector<Mat3>& precond,
                               const std::vector<Vec3>& b, double eta, int max_iterations, std::vector<Vec3>& d);
 
+/// The shift σ of a matrix that may be indefinite (Newton, implicit Euler): CG on A + σ D, D the
+/// diagonal blocks of A, with σ grown tenfold from 10⁻³ while CG meets negative curvature, up to 10³
+/// (a Levenberg–Marquardt shift towards scaled steepest descent). It carries over between solves;
+/// relax() shrinks it tenfold after a solve the caller judged good.
+struct Shift {
+  double sigma = 0.0;
+  void relax() { sigma = sigma > kFirst ? 0.1 * sigma : 0.0; }
+  static constexpr double kFirst = 1e-3, kMax = 1e3;
+};
+/// Solves (A + σ D) d = b as conjugate_gradients does, growing `shift` as it needs; `iterations`
+/// counts every attempt's. negative_curvature is set only when even σ = 10³ did not make CG complete.
+CgOutcome shifted_conjugate_gradients(const Mesh& m, const LinearOperator& A, const std::vector<Mat3>& blocks,
+                                      const std::vector<Mat3>& precond, const std::vector<Vec3>& b, double eta,
+                                      int max_iterations, Shift& shift, std::vector<Vec3>& d);
+
 }  // namespace pneumo

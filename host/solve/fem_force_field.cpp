@@ -124,9 +124,9 @@ class FemForceField final : public ForceField {
     // |V₀ (δP(e_b ⊗ ∇N_j) ∇N_i)_a|.
     const int64_t T = int64_t(m_.tets.size());
     std::vector<std::array<double, 12>> rows(T);
+    const ElementState rest = element_state(law_, Mat3::Identity());
 #pragma omp parallel for schedule(static) if (T > 20000)
     for (int64_t t = 0; t < T; ++t) {
-      const ElementState rest = element_state(law_, Mat3::Identity());
       const Mat3& Dinv = tets_.rest[t].dm_inverse;
       const Vec3 grads[4] = {-(Dinv.row(0) + Dinv.row(1) + Dinv.row(2)).transpose(), Dinv.row(0).transpose(),
                              Dinv.row(1).transpose(), Dinv.row(2).transpose()};

@@ -2,6 +2,7 @@
 
 #include <optional>
 #include <stdexcept>
+#include <string>
 
 #include "mesh/adjacency.h"
 #include "solve/fem_tets.h"
@@ -12,8 +13,12 @@ namespace pneumo {
 namespace {
 
 constexpr std::size_t kLocal = 64;   // the work-group size every pneumo kernel runs with
-constexpr int kStateFloats = 40;     // fem_forces.cl
-constexpr int kStateE = 27;
+// The element state's layout shared with fem_forces.cl (passed as build options): floats per
+// tetrahedron, and where its dilatation e and deviatoric energy density ψ sit.
+constexpr int kStateFloats = 40;
+constexpr int kStateE = 27, kStatePsi = 32;
+const std::string kStateOptions = "-DkStateFloats=" + std::to_string(kStateFloats) +
+                                  " -DS_E=" + std::to_string(kStateE) + " -DS_PSI=" + std::to_string(kStatePsi);
 
 std::size_t global_size(int64_t n) { return (std::size_t(std::max<int64_t>(n, 1)) + kLocal - 1) / kLocal * kLocal; }
 
@@ -67,14 +72,14 @@ class ClFemForceField final : public ForceField {
     dF_ = rw(std::size_t(T_) * 10 * sizeof(float));
     blocks_ = rw(std::size_t(12 * T_) * sizeof(cl_float4));
     node_blocks_ = rw(std::size_t(3 * N_) * sizeof(cl_float4));
-    k_states_ = ctx.kernel("fem_forces.cl", "fem_states");
-    k_average_ = ctx.kernel("fem_forces.cl", "fem_group_average");
-    k_forces_ = ctx.kernel("fem_forces.cl", "fem_forces");
-    k_dF_ = ctx.kernel("fem_forces.cl", "fem_dF");
-    k_dforces_ = ctx.kernel("fem_forces.cl", "fem_dforces");
-    k_diagonal_ = ctx.kernel("fem_forces.cl", "fem_diagonal");
-    k_gather_ = ctx.kernel("fem_forces.cl", "fem_gather");
-    k_gather_diagonal_ = ctx.kernel("fem_forces.cl", "fem_gather_diagonal");
+    k_states_ = ctx.kernel("fem_forces.cl", "fem_states", kStateOptions);
+    k_average_ = ctx.kernel("fem_forces.cl", "fem_group_average", kStateOptions);
+    k_forces_ = ctx.kernel("fem_forces.cl", "fem_forces", kStateOptions);
+    k_dF_ = ctx.kernel("fem_forces.cl", "fem_dF", kStateOptions);
+    k_dforces_ = ctx.kernel("fem_forces.cl", "fem_dforces", kStateOptions);
+    k_diagonal_ = ctx.kernel("fem_forces.cl", "fem_diagonal", kStateOptions);
+    k_gather_ = ctx.kernel("fem_forces.cl", "fem_gather", kStateOptions);
+    k_gather_diagonal_ = ctx.kernel("fem_forces.cl", "fem_gather_diagonal", kStateOptions);
     k_load_ = ctx.kernel("msd_forces.cl", "load_pressure", "-DW=8");
   }
 
@@ -106,7 +111,7 @@ class ClFemForceField final : public ForceField {
     if (T_ > 0) q.enqueueReadBuffer(state_, CL_TRUE, 0, st.size() * sizeof(float), st.data());
     if (!ebar.empty()) q.enqueueReadBuffer(ebar_, CL_TRUE, 0, ebar.size() * sizeof(float), ebar.data());
     double e = 0.0;
-    for (int64_t t = 0; t < T_; ++t) e += tets_.rest[t].volume_m3 * double(st[kStateFloats * t + 32]);
+    for (int64_t t = 0; t < T_; ++t) e += tets_.rest[t].volume_m3 * double(st[kStateFloats * t + kStatePsi]);
     for (std::size_t g = 0; g < ebar.size(); ++g) e += 0.5 * groups_->weight[g] * double(ebar[g]) * double(ebar[g]);
     return e;
   }

@@ -7,8 +7,8 @@
 // every model alike. For a positive K the matrix is positive definite at any h, so the scheme is
 // stable at any step (it damps what it cannot resolve); h sets how closely it follows the ramp:
 // solver.dt_ms, or 0 for the ramp in 50 steps. CG is preconditioned by the blocks
-// (1 + hα) m_i I + h(h + β) K_ii and solved to 10⁻⁴; where K is indefinite the matrix takes Newton's
-// shift (solve_newton.cpp).
+// (1 + hα) m_i I + h(h + β) K_ii and solved to 10⁻⁴; where K is indefinite the matrix takes the shift
+// Newton uses (conjugate_gradients.h).
 #include <cmath>
 #include <sstream>
 
@@ -23,7 +23,6 @@ namespace pneumo {
 namespace {
 constexpr double kCgTolerance = 1e-4;
 constexpr int kRampSteps = 50;
-constexpr double kFirstShift = 1e-3, kMaxShift = 1e3;
 }  // namespace
 
 SolveResult solve_implicit_euler(const Mesh& m, const SolveOptions& opt, std::vector<Vec3> x) {
@@ -47,7 +46,8 @@ SolveResult solve_implicit_euler(const Mesh& m, const SolveOptions& opt, std::ve
   std::vector<Vec3> v(N, Vec3::Zero()), f, kv, b(N), dv;
   std::vector<Mat3> blocks, a_blocks(N);
   int64_t step = 0, cg_iterations = 0;
-  double residual = INFINITY, shift = 0.0;
+  double residual = INFINITY;
+  Shift shift;
   std::string reason;
   const double k_scale = h * (h + beta);
   while (step < opt.max_steps) {
@@ -63,20 +63,15 @@ SolveResult solve_implicit_euler(const Mesh& m, const SolveOptions& opt, std::ve
     pressure.add_product(v, kv);
     for (int64_t n = 0; n < N; ++n) b[n] = h * (f[n] - (h + beta) * kv[n] - alpha * m.mass_kg[n] * v[n]);
     detail::apply_holds(m, b);
-    CgOutcome cg;
-    for (;;) {
-      const LinearOperator A = [&](const std::vector<Vec3>& p, std::vector<Vec3>& ap) {
-        field->stiffness_product(p, ap);
-        pressure.add_product(p, ap);
-        for (int64_t n = 0; n < N; ++n)
-          ap[n] = (1.0 + h * alpha) * m.mass_kg[n] * p[n] + k_scale * ap[n] + shift * (a_blocks[n] * p[n]);
-      };
-      cg = conjugate_gradients(m, A, precond, b, kCgTolerance, opt.newton_max_cg_iterations, dv);
-      cg_iterations += cg.iterations;
-      if (!cg.negative_curvature || shift > kMaxShift) break;
-      shift = shift > 0.0 ? 10.0 * shift : kFirstShift;
-    }
-    if (!cg.negative_curvature) shift = shift > kFirstShift ? 0.1 * shift : 0.0;
+    const LinearOperator A = [&](const std::vector<Vec3>& p, std::vector<Vec3>& ap) {
+      field->stiffness_product(p, ap);
+      pressure.add_product(p, ap);
+      for (int64_t n = 0; n < N; ++n) ap[n] = (1.0 + h * alpha) * m.mass_kg[n] * p[n] + k_scale * ap[n];
+    };
+    const CgOutcome cg =
+        shifted_conjugate_gradients(m, A, a_blocks, precond, b, kCgTolerance, opt.newton_max_cg_iterations, shift, dv);
+    cg_iterations += cg.iterations;
+    if (!cg.negative_curvature) shift.relax();
     for (int64_t n = 0; n < N; ++n) v[n] += dv[n];
     detail::apply_holds(m, v);
     for (int64_t n = 0; n < N; ++n) x[n] += h * v[n];

@@ -47,8 +47,7 @@ SolveResult solve_newton_on(const Mesh& m, const SolveOptions& opt, ForceField& 
   std::vector<Vec3> f, trial(N), f_trial, d;
   std::vector<Mat3> blocks;
   PressureStiffness pressure;
-  constexpr double kFirstShift = 1e-3, kMaxShift = 1e3;
-  double shift = 0.0;
+  Shift shift;
   int64_t step = 0, cg_iterations = 0;
   double residual = INFINITY;
   bool converged = false;
@@ -71,21 +70,13 @@ SolveResult solve_newton_on(const Mesh& m, const SolveOptions& opt, ForceField& 
       const double eta = std::isfinite(previous_norm)
                              ? std::clamp(0.9 * (norm / previous_norm) * (norm / previous_norm), 1e-3, 0.1)
                              : 0.1;
-      // At negative curvature: the shifted system K + σ D (above).
-      CgOutcome cg;
-      for (;;) {
-        const LinearOperator K = [&](const std::vector<Vec3>& p, std::vector<Vec3>& kp) {
-          field.stiffness_product(p, kp);
-          pressure.add_product(p, kp);
-          if (shift > 0.0)
-            for (int64_t n = 0; n < N; ++n) kp[n] += shift * (blocks[n] * p[n]);
-        };
-        cg = conjugate_gradients(m, K, precond, f, eta, opt.newton_max_cg_iterations, d);
-        cg_iterations += cg.iterations;
-        if (!cg.negative_curvature) break;
-        shift = shift > 0.0 ? 10.0 * shift : kFirstShift;
-        if (shift > kMaxShift) break;
-      }
+      const LinearOperator K = [&](const std::vector<Vec3>& p, std::vector<Vec3>& kp) {
+        field.stiffness_product(p, kp);
+        pressure.add_product(p, kp);
+      };
+      const CgOutcome cg =
+          shifted_conjugate_gradients(m, K, blocks, precond, f, eta, opt.newton_max_cg_iterations, shift, d);
+      cg_iterations += cg.iterations;
 
       // Backtracking on |f|: halve until it falls enough and no further tetrahedron inverts.
       double alpha = 1.0, trial_norm = INFINITY;
@@ -101,7 +92,7 @@ SolveResult solve_newton_on(const Mesh& m, const SolveOptions& opt, ForceField& 
         if ((accepted = trial_inverted <= inverted)) break;
       }
       if (!accepted) { reason = "no descent"; break; }
-      if (alpha == 1.0) shift = shift > kFirstShift ? 0.1 * shift : 0.0;
+      if (alpha == 1.0) shift.relax();
       x.swap(trial);
       f.swap(f_trial);
       previous_norm = norm;
