@@ -191,6 +191,10 @@ TEST(SceneRoundTrip, EveryKeyChangesItsOwnValueOnly) {
       companions.push_back(json::json_pointer("/solver/method"));
       changed[companions.back()] = "newton";
     }
+    if (path == "material.tilt_deg") {   // a tilt needs gravity (scene_validate.cpp)
+      companions.push_back(json::json_pointer("/material/gravity"));
+      changed[companions.back()] = true;
+    }
     if (path == "render.ports[0].target_label") {
       companions.push_back(ptr.parent_pointer() / "target_mm");
       changed[companions.back()] = nullptr;

@@ -57,6 +57,22 @@ struct MeshOptions {
   std::optional<Vec3> roi_min_mm, roi_max_mm;   // cubes whose centre lies outside are not meshed
 };
 
+/// The surfaces the contact term keeps apart (solve/contact.h): the viscera's surface (every face of a
+/// viscera voxel towards a voxel that is not viscera), the wall's side of the cavity (every face of a
+/// wall voxel towards a viscera voxel) and the bone near the viscera (every face of a fixed voxel
+/// towards neither bone nor wall, in or next to a cube the viscera mesh). A tissue face is a point embedded in the tetrahedron of its part that holds the face's centre
+/// (barycentric weights w) with c = cof(D_m)⁻¹ N dA = D_mᵀ N dA / det D_m, so that cof(D_s)·c is its
+/// deformed area vector out of its own tissue (Nanson, as the pressure loads). A fixed face does not
+/// move: its centre and its area vector out of the bone. Metres and m².
+struct ContactFaces {
+  std::vector<int32_t> tet;
+  std::vector<std::array<double, 4>> w;
+  std::vector<Vec3> c;
+  std::vector<Part> part;
+  std::vector<Vec3> fixed_centre_m, fixed_area_m2;
+  std::size_t size() const { return tet.size(); }
+};
+
 struct MeshStats {
   int64_t nodes = 0, tetrahedra = 0, springs = 0, fixed_nodes = 0;
   int64_t cavity_faces = 0;        // voxel faces between wall and viscera, both sides counted
@@ -99,6 +115,7 @@ struct Mesh {
   // affine map. A face of the tetrahedron itself is the special case of the old cavity triangles.
   std::vector<int32_t> load_tet;
   std::vector<std::array<Vec3, 4>> load_c;
+  ContactFaces contact;
 
   // Where it came from.
   Geometry grid;                            // the voxel grid

@@ -126,6 +126,7 @@ bool touches_fixed(const VoxelRoles& roles, int64_t a, int64_t b, int64_t c, int
 /// The pressure loads (mesh.h): every voxel face between a voxel of part p and one of the other
 /// part's role, split into 4 triangles (centre and each edge) so each lies in one tetrahedron face
 /// when L = 1, carried by part p's tetrahedron in the voxel's cube that holds the triangle's centroid.
+/// The same faces make the contact surfaces between wall and viscera (mesh.h).
 void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, int L,
                           const std::vector<uint8_t>& meshed, const std::vector<int32_t> (&first_tet)[kParts]) {
   const Geometry& g = roles.geometry;
@@ -135,9 +136,11 @@ void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
     int64_t faces;
   };
   std::vector<std::vector<Accum>> per_slab(std::size_t(lat.cubes[2]));
+  std::vector<ContactFaces> contact_per_slab(std::size_t(lat.cubes[2]));
 #pragma omp parallel for schedule(dynamic)
   for (int64_t c = 0; c < lat.cubes[2]; ++c) {
     std::vector<Accum>& out = per_slab[c];
+    ContactFaces& contact = contact_per_slab[c];
     for (int64_t b = 0; b < lat.cubes[1]; ++b)
       for (int64_t a = 0; a < lat.cubes[0]; ++a) {
         const int64_t q = lat.cube_index(a, b, c);
@@ -160,7 +163,12 @@ void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
                   int64_t n[3] = {i, j, k};
                   n[axis] += side;
                   if (n[axis] < 0 || n[axis] >= g.dims[axis]) continue;
-                  if (roles.role[g.linear_index(n[0], n[1], n[2])] != other) continue;
+                  // The viscera's whole surface is the contact's slave side (solve/contact.h); the
+                  // wall's faces towards viscera are its master side and, with the viscera's towards
+                  // the wall, the cavity's.
+                  const Role beyond = roles.role[g.linear_index(n[0], n[1], n[2])];
+                  const bool cavity = beyond == other;
+                  if (!cavity && !(p == 1 && beyond != Role::Viscera)) continue;
                   // The face's centre and corners in index space; the 4 triangles (centre, corner q, q+1).
                   const int u = (axis + 1) % 3, w = (axis + 2) % 3;
                   Vec3 centre = Vec3(double(i), double(j), double(k));
@@ -168,6 +176,31 @@ void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
                   const double cu[4] = {-0.5, 0.5, 0.5, -0.5}, cw[4] = {-0.5, -0.5, 0.5, 0.5};
                   const Vec3 outward_world = g.to_world(Vec3(double(n[0]), double(n[1]), double(n[2]))) -
                                              g.to_world(Vec3(double(idx[0]), double(idx[1]), double(idx[2])));
+                  // The whole face's area vector out of the tissue: the parallelogram of its index edges.
+                  const Vec3 centre_m = g.to_world(centre) * units::kMetresPerMm;
+                  Vec3 du = Vec3::Zero(), dw = Vec3::Zero();
+                  du[u] = 1.0;
+                  dw[w] = 1.0;
+                  Vec3 face_area = ((g.to_world(centre + du) - g.to_world(centre)).cross(g.to_world(centre + dw) -
+                                                                                          g.to_world(centre))) *
+                                   (units::kMetresPerMm * units::kMetresPerMm);
+                  if (face_area.dot(outward_world) < 0) face_area = -face_area;
+                  {
+                    const std::array<double, 3> uc{(centre[0] + 0.5 - double(a * L)) / L,
+                                                   (centre[1] + 0.5 - double(b * L)) / L,
+                                                   (centre[2] + 0.5 - double(c * L)) / L};
+                    const int32_t tet = first_tet[p][q] + lattice::tet_holding(uc, odd);
+                    const auto& tv = m.tets[tet];
+                    Mat3 dm;
+                    dm << m.rest_m[tv[1]] - m.rest_m[tv[0]], m.rest_m[tv[2]] - m.rest_m[tv[0]],
+                        m.rest_m[tv[3]] - m.rest_m[tv[0]];
+                    const Vec3 wts = dm.inverse() * (centre_m - m.rest_m[tv[0]]);
+                    contact.tet.push_back(tet);
+                    contact.w.push_back({1.0 - wts.sum(), wts[0], wts[1], wts[2]});
+                    contact.c.push_back(dm.transpose() * face_area / dm.determinant());
+                    contact.part.push_back(Part(p));
+                  }
+                  if (!cavity) continue;
                   for (int t = 0; t < 4; ++t) {
                     Vec3 p1 = centre, p2 = centre;
                     p1[u] += cu[t];
@@ -207,6 +240,13 @@ void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
         }
       }
   }
+  for (const ContactFaces& slab : contact_per_slab) {
+    ContactFaces& all = m.contact;
+    all.tet.insert(all.tet.end(), slab.tet.begin(), slab.tet.end());
+    all.w.insert(all.w.end(), slab.w.begin(), slab.w.end());
+    all.c.insert(all.c.end(), slab.c.begin(), slab.c.end());
+    all.part.insert(all.part.end(), slab.part.begin(), slab.part.end());
+  }
   for (const auto& slab : per_slab)
     for (const Accum& ac : slab) {
       const auto& tv = m.tets[ac.tet];
@@ -221,6 +261,54 @@ void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
       m.stats.cavity_faces += ac.faces;
     }
   m.stats.pressure_tetrahedra = int64_t(m.load_tet.size());
+}
+
+/// The bone the viscera may be pushed against (mesh.h's ContactFaces): every face of a fixed voxel
+/// towards a voxel that is neither fixed nor wall (viscera, or the space between), in a cube the
+/// viscera mesh or next to one. The wall's side of bone is left out: the viscera reach it only through
+/// the wall, whose own faces already stop them.
+void build_bone_obstacles(Mesh& m, const VoxelRoles& roles, const Lattice& lat, int L,
+                          const std::vector<uint8_t>& meshed) {
+  const Geometry& g = roles.geometry;
+  std::vector<uint8_t> near_viscera(meshed.size(), 0);   // the viscera's cubes dilated by one
+  for (int64_t c = 0; c < lat.cubes[2]; ++c)
+    for (int64_t b = 0; b < lat.cubes[1]; ++b)
+      for (int64_t a = 0; a < lat.cubes[0]; ++a) {
+        if (!(meshed[lat.cube_index(a, b, c)] & 2)) continue;
+        for (int64_t z = c - 1; z <= c + 1; ++z)
+          for (int64_t y = b - 1; y <= b + 1; ++y)
+            for (int64_t x = a - 1; x <= a + 1; ++x)
+              if (lat.inside(x, y, z)) near_viscera[lat.cube_index(x, y, z)] = 1;
+      }
+  auto viscera_cube = [&](int64_t i, int64_t j, int64_t k) {
+    return near_viscera[lat.cube_index(i / L, j / L, k / L)] != 0;
+  };
+  const double mm2_to_m2 = units::kMetresPerMm * units::kMetresPerMm;
+  for (int64_t k = 0; k < g.dims[2]; ++k)
+    for (int64_t j = 0; j < g.dims[1]; ++j)
+      for (int64_t i = 0; i < g.dims[0]; ++i) {
+        if (roles.role[g.linear_index(i, j, k)] != Role::Fixed) continue;
+        for (int axis = 0; axis < 3; ++axis)
+          for (int side = -1; side <= 1; side += 2) {
+            int64_t n[3] = {i, j, k};
+            n[axis] += side;
+            if (n[axis] < 0 || n[axis] >= g.dims[axis]) continue;
+            const Role beyond = roles.role[g.linear_index(n[0], n[1], n[2])];
+            if (beyond == Role::Fixed || beyond == Role::Wall) continue;
+            if (!viscera_cube(i, j, k)) continue;
+            Vec3 centre = Vec3(double(i), double(j), double(k)), du = Vec3::Zero(), dw = Vec3::Zero();
+            centre[axis] += 0.5 * side;
+            du[(axis + 1) % 3] = 1.0;
+            dw[(axis + 2) % 3] = 1.0;
+            const Vec3 c = g.to_world(centre);
+            Vec3 area = (g.to_world(centre + du) - c).cross(g.to_world(centre + dw) - c) * mm2_to_m2;
+            const Vec3 out = g.to_world(Vec3(double(n[0]), double(n[1]), double(n[2]))) -
+                             g.to_world(Vec3(double(i), double(j), double(k)));
+            if (area.dot(out) < 0) area = -area;
+            m.contact.fixed_centre_m.push_back(c * units::kMetresPerMm);
+            m.contact.fixed_area_m2.push_back(area);
+          }
+      }
 }
 
 }  // namespace
@@ -339,6 +427,7 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
       }
 
   build_pressure_loads(m, roles, lat, L, meshed, first_tet);
+  if (with_viscera) build_bone_obstacles(m, roles, lat, L, meshed);
 
   // Springs: unique tetrahedron edges (per part: parts never share nodes).
   std::vector<std::pair<int64_t, int64_t>> edges;   // (node-pair key, 6·tet + local edge)

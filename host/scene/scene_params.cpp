@@ -188,6 +188,16 @@ const Table<SceneMaterial>& material_table() {
        "other solvers."},
       {"gravity", &SceneMaterial::gravity, "", any(),
        "Apply gravity (9.81 m/s², towards posterior: supine). The CT already shows the body under gravity (§5)."},
+      {"tilt_deg", &SceneMaterial::tilt_deg, "deg", in(-45, 45),
+       "Table tilt about the left-right axis with gravity on: > 0 head down (Trendelenburg, 15-30 in pelvic "
+       "surgery), < 0 head up (reverse Trendelenburg, upper abdomen); gravity then has 9.81·sin(tilt) towards the "
+       "head."},
+      {"contact", &SceneMaterial::contact, "", any(),
+       "Keep the viscera out of the wall and the bone: frictionless penalty contact on the cavity faces, sliding "
+       "(solve/contact.h). Needs solver.method \"static\", \"newton\" or \"implicit-euler\"."},
+      {"contact_stiffness", &SceneMaterial::contact_stiffness, "", above(0, 1e4),
+       "κ of the contact penalty k = κ·E/h per unit area (E the stiffer tissue, h the cube edge): penetration "
+       "p_c·h/(κ·E) at contact pressure p_c."},
   };
   return t;
 }

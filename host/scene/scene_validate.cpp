@@ -58,6 +58,15 @@ void check_label_young(const SceneMaterial& m, const At& material) {
 // the co-rotational law has no stiffening.
 void check_material_model(const Scene& s, const At& root) {
   const SceneMaterial& m = s.material;
+  // The contact term lives in the force fields (solve/contact.h); the explicit schemes and the 2004
+  // scheme call the springs' evaluator directly.
+  if (m.contact && s.solver.method != SolverMethod::Newton && s.solver.method != SolverMethod::Static &&
+      s.solver.method != SolverMethod::ImplicitEuler)
+    root.child("solver").child("method").fail_value(enum_name(s.solver.method),
+                                                    "cannot solve with material.contact; use \"newton\", \"static\" "
+                                                    "or \"implicit-euler\", or set contact to false");
+  if (m.tilt_deg != 0.0 && !m.gravity)
+    root.child("material").child("tilt_deg").fail_value(m.tilt_deg, "tilts gravity, which is off: set gravity to true");
   if (m.model == MaterialModel::Msd) return;
   // The explicit schemes need the springs' dampers and stable step, the 2004 scheme their stiffness
   // sums; the finite elements have neither (docs/fem.md). Implicit Euler damps by Rayleigh's C.

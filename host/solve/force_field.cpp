@@ -3,15 +3,23 @@
 
 #include <stdexcept>
 
+#include "solve/contact.h"
+
 namespace pneumo {
 
-std::unique_ptr<ForceField> make_force_field(const Mesh& m, const ForceModel& model) {
+namespace {
+std::unique_ptr<ForceField> make_material_field(const Mesh& m, const ForceModel& model) {
   switch (model.material) {
     case MaterialModel::Msd: return make_spring_force_field(m);
     case MaterialModel::FemCorotational:
     case MaterialModel::FemNeoHookean: return make_fem_force_field(m, model.material);
   }
   throw std::logic_error("unknown material model");
+}
+}  // namespace
+
+std::unique_ptr<ForceField> make_force_field(const Mesh& m, const ForceModel& model) {
+  return with_contact(m, model, make_material_field(m, model));
 }
 
 }  // namespace pneumo

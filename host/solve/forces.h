@@ -17,6 +17,7 @@ struct ForceModel {
   double pressure_pa = 0.0;            // gas pressure on the cavity faces (mesh.h)
   double volume_stiffness_pa = 0.0;    // Kitasaka's k_v; 0 = off
   Vec3 gravity_m_s2 = Vec3::Zero();    // option (Bano); zero = off
+  double contact_stiffness = 0.0;      // κ of the viscera's contact with wall and bone (contact.h); 0 = off
   double stiffening = 0.0;             // b of the exponential spring law (stiffened_strain), or of
                                        // Demiray's law for fem-neohookean; 0 = linear / neo-Hookean
 };

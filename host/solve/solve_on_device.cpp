@@ -3,6 +3,7 @@
 #include <atomic>
 
 #include "core/log.h"
+#include "solve/contact.h"
 #include "solve/fem_force_field_cl.h"
 #include "solve/force_field.h"
 #include "solve/solver_cl.h"
@@ -12,6 +13,7 @@ namespace pneumo {
 bool device_implements(const SolveOptions& opt) {
   const bool fem = opt.forces.material != MaterialModel::Msd;
   if (opt.method == SolverMethod::ImplicitEuler) return false;
+  if (opt.forces.contact_stiffness > 0.0 && !fem) return false;   // the springs' device schemes have no contact
   return opt.method == SolverMethod::Newton ? fem : !fem;
 }
 
@@ -19,15 +21,17 @@ SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions
                             const std::vector<Vec3>& x_start) {
   if (ctx && device_implements(opt)) {
     if (opt.method != SolverMethod::Newton) return solve_opencl(*ctx, m, opt, x_start);
-    const std::unique_ptr<ForceField> field = make_fem_force_field_cl(*ctx, m, opt.forces.material);
+    const std::unique_ptr<ForceField> field =
+        with_contact(m, opt.forces, make_fem_force_field_cl(*ctx, m, opt.forces.material));
     return solve_newton_on(m, opt, *field, x_start);
   }
   if (ctx) {
     static std::atomic<bool> said{false};
     if (!said.exchange(true))
       log::info(std::string("solving on the CPU: on OpenCL, newton solves the finite elements and the other "
-                            "schemes the springs, not ") +
-                enum_name(opt.method) + " with " + enum_name(opt.forces.material));
+                            "schemes the springs without contact, not ") +
+                enum_name(opt.method) + " with " + enum_name(opt.forces.material) +
+                (opt.forces.contact_stiffness > 0.0 ? " and contact" : ""));
   }
   return solve(m, opt, x_start);
 }

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/error.h"
 #include "core/units.h"
 #include "scene/scene.h"
 #include "solve/solver_common.h"
@@ -48,7 +49,10 @@ SolveOptions solve_options_from_scene(const Scene& s) {
   o.forces.stiffening = s.material.stiffening;
   o.forces.pressure_pa = units::mmhg_to_pa(s.load.pressure_mmhg);
   o.forces.volume_stiffness_pa = units::kpa_to_pa(s.effective_volume_stiffness_kpa());
-  if (s.material.gravity) o.forces.gravity_m_s2 = Vec3(0, -9.81, 0);   // supine: down is posterior (−y in RAS)
+  // Supine, down is posterior (−y in RAS); tilted head down by θ, sin θ of it points to the head (+z).
+  const double tilt = s.material.tilt_deg * (3.14159265358979323846 / 180.0);
+  if (s.material.gravity) o.forces.gravity_m_s2 = 9.81 * Vec3(0, -std::cos(tilt), std::sin(tilt));
+  if (s.material.contact) o.forces.contact_stiffness = s.material.contact_stiffness;
   o.dt_s = units::ms_to_s(s.solver.dt_ms);
   o.dt_safety = s.solver.dt_safety;
   o.max_steps = s.solver.max_steps;
@@ -72,6 +76,11 @@ SolveOptions solve_options_from_scene(const Scene& s) {
 
 SolveResult solve(const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x_start) {
   std::vector<Vec3> x = x_start.empty() ? m.rest_m : x_start;
+  const bool field_solver = opt.method == SolverMethod::Static || opt.method == SolverMethod::Newton ||
+                            opt.method == SolverMethod::ImplicitEuler;
+  if (opt.forces.contact_stiffness > 0.0 && !field_solver)
+    throw InputError(std::string("contact needs solver.method \"static\", \"newton\" or \"implicit-euler\", not \"") +
+                     enum_name(opt.method) + "\"");
   switch (opt.method) {
     case SolverMethod::Explicit: return solve_explicit(m, opt, std::move(x));
     case SolverMethod::Newmark: return solve_newmark(m, opt, std::move(x));
