@@ -158,6 +158,13 @@ double enclosed_cavity_volume(const Mesh& m, const std::vector<Vec3>& x, const V
 /// The pressure's nodal forces at positions x (one entry per node).
 std::vector<Vec3> pressure_forces(const Mesh& m, const std::vector<Vec3>& x, double pressure_pa);
 
+/// cof(D_s)·c for a tetrahedron's edges e_k = x_k − x_0: c.x (e2×e3) + c.y (e3×e1) + c.z (e1×e2), the
+/// deformed area vector of an embedded face with c = cof(D_m)⁻¹ N dA (Nanson; the pressure loads and
+/// the contact faces).
+inline Vec3 cofactor_times(const Vec3& e1, const Vec3& e2, const Vec3& e3, const Vec3& c) {
+  return c[0] * e2.cross(e3) + c[1] * e3.cross(e1) + c[2] * e1.cross(e2);
+}
+
 /// Signed volume of the tetrahedron (a,b,c,d), positive when (b−a, c−a, d−a) is right-handed.
 inline double signed_tet_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return (b - a).cross(c - a).dot(d - a) / 6.0;

@@ -123,6 +123,43 @@ bool touches_fixed(const VoxelRoles& roles, int64_t a, int64_t b, int64_t c, int
   return false;
 }
 
+/// The face of voxel (i,j,k) on its `side` (±1) along `axis`: its centre in index space, and in world
+/// metres with its area vector (m²) out of the voxel.
+struct VoxelFace {
+  Vec3 centre_index, centre_m, area_m2;
+};
+VoxelFace voxel_face(const Geometry& g, int64_t i, int64_t j, int64_t k, int axis, int side) {
+  VoxelFace f;
+  f.centre_index = Vec3(double(i), double(j), double(k));
+  f.centre_index[axis] += 0.5 * side;
+  Vec3 du = Vec3::Zero(), dw = Vec3::Zero(), out = Vec3::Zero();
+  du[(axis + 1) % 3] = 1.0;
+  dw[(axis + 2) % 3] = 1.0;
+  out[axis] = side;
+  const Vec3 c = g.to_world(f.centre_index);
+  f.centre_m = c * units::kMetresPerMm;
+  f.area_m2 = (g.to_world(f.centre_index + du) - c).cross(g.to_world(f.centre_index + dw) - c) *
+              (units::kMetresPerMm * units::kMetresPerMm);
+  if (f.area_m2.dot(g.to_world(f.centre_index + out) - c) < 0) f.area_m2 = -f.area_m2;
+  return f;
+}
+
+/// Barycentric weights of world point x_m (metres) in tetrahedron t at rest.
+std::array<double, 4> rest_barycentric(const Mesh& m, int32_t t, const Vec3& x_m) {
+  const auto& tv = m.tets[t];
+  const Vec3& X0 = m.rest_m[tv[0]];
+  Mat3 dm;
+  dm << m.rest_m[tv[1]] - X0, m.rest_m[tv[2]] - X0, m.rest_m[tv[3]] - X0;
+  const Vec3 w = dm.inverse() * (x_m - X0);
+  return {1.0 - w.sum(), w[0], w[1], w[2]};
+}
+
+/// Cube (a,b,c)'s local coordinates u ∈ [0,1]³ of a point given in voxel index space.
+std::array<double, 3> cube_local(const Vec3& index, int64_t a, int64_t b, int64_t c, int L) {
+  return {(index[0] + 0.5 - double(a * L)) / L, (index[1] + 0.5 - double(b * L)) / L,
+          (index[2] + 0.5 - double(c * L)) / L};
+}
+
 /// The pressure loads (mesh.h): every voxel face between a voxel of part p and one of the other
 /// part's role, split into 4 triangles (centre and each edge) so each lies in one tetrahedron face
 /// when L = 1, carried by part p's tetrahedron in the voxel's cube that holds the triangle's centroid.
@@ -157,7 +194,6 @@ void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
               const int p = r == Role::Wall ? 0 : 1;
               if (!(meshed[q] & (1 << p))) continue;
               const Role other = p == 0 ? Role::Viscera : Role::Wall;
-              const int64_t idx[3] = {i, j, k};
               for (int axis = 0; axis < 3; ++axis)
                 for (int side = -1; side <= 1; side += 2) {
                   int64_t n[3] = {i, j, k};
@@ -169,38 +205,24 @@ void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
                   const Role beyond = roles.role[g.linear_index(n[0], n[1], n[2])];
                   const bool cavity = beyond == other;
                   if (!cavity && !(p == 1 && beyond != Role::Viscera)) continue;
-                  // The face's centre and corners in index space; the 4 triangles (centre, corner q, q+1).
-                  const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-                  Vec3 centre = Vec3(double(i), double(j), double(k));
-                  centre[axis] += 0.5 * side;
-                  const double cu[4] = {-0.5, 0.5, 0.5, -0.5}, cw[4] = {-0.5, -0.5, 0.5, 0.5};
-                  const Vec3 outward_world = g.to_world(Vec3(double(n[0]), double(n[1]), double(n[2]))) -
-                                             g.to_world(Vec3(double(idx[0]), double(idx[1]), double(idx[2])));
-                  // The whole face's area vector out of the tissue: the parallelogram of its index edges.
-                  const Vec3 centre_m = g.to_world(centre) * units::kMetresPerMm;
-                  Vec3 du = Vec3::Zero(), dw = Vec3::Zero();
-                  du[u] = 1.0;
-                  dw[w] = 1.0;
-                  Vec3 face_area = ((g.to_world(centre + du) - g.to_world(centre)).cross(g.to_world(centre + dw) -
-                                                                                          g.to_world(centre))) *
-                                   (units::kMetresPerMm * units::kMetresPerMm);
-                  if (face_area.dot(outward_world) < 0) face_area = -face_area;
+                  const VoxelFace face = voxel_face(g, i, j, k, axis, side);
                   {
-                    const std::array<double, 3> uc{(centre[0] + 0.5 - double(a * L)) / L,
-                                                   (centre[1] + 0.5 - double(b * L)) / L,
-                                                   (centre[2] + 0.5 - double(c * L)) / L};
-                    const int32_t tet = first_tet[p][q] + lattice::tet_holding(uc, odd);
+                    const int32_t tet =
+                        first_tet[p][q] + lattice::tet_holding(cube_local(face.centre_index, a, b, c, L), odd);
                     const auto& tv = m.tets[tet];
                     Mat3 dm;
                     dm << m.rest_m[tv[1]] - m.rest_m[tv[0]], m.rest_m[tv[2]] - m.rest_m[tv[0]],
                         m.rest_m[tv[3]] - m.rest_m[tv[0]];
-                    const Vec3 wts = dm.inverse() * (centre_m - m.rest_m[tv[0]]);
                     contact.tet.push_back(tet);
-                    contact.w.push_back({1.0 - wts.sum(), wts[0], wts[1], wts[2]});
-                    contact.c.push_back(dm.transpose() * face_area / dm.determinant());
+                    contact.w.push_back(rest_barycentric(m, tet, face.centre_m));
+                    contact.c.push_back(dm.transpose() * face.area_m2 / dm.determinant());
                     contact.part.push_back(Part(p));
                   }
                   if (!cavity) continue;
+                  // The 4 triangles (centre, corner t, corner t+1) in index space.
+                  const Vec3& centre = face.centre_index;
+                  const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+                  const double cu[4] = {-0.5, 0.5, 0.5, -0.5}, cw[4] = {-0.5, -0.5, 0.5, 0.5};
                   for (int t = 0; t < 4; ++t) {
                     Vec3 p1 = centre, p2 = centre;
                     p1[u] += cu[t];
@@ -208,22 +230,13 @@ void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
                     p2[u] += cu[(t + 1) % 4];
                     p2[w] += cw[(t + 1) % 4];
                     const Vec3 centroid = (centre + p1 + p2) / 3.0;
-                    const Vec3 x0 = g.to_world(centre) * units::kMetresPerMm, x1 = g.to_world(p1) * units::kMetresPerMm,
-                               x2 = g.to_world(p2) * units::kMetresPerMm;
-                    Vec3 area = 0.5 * (x1 - x0).cross(x2 - x0);
-                    if (area.dot(outward_world) < 0) area = -area;
-                    const std::array<double, 3> uc{(centroid[0] + 0.5 - double(a * L)) / L,
-                                                   (centroid[1] + 0.5 - double(b * L)) / L,
-                                                   (centroid[2] + 0.5 - double(c * L)) / L};
-                    const int kt = lattice::tet_holding(uc, odd);
+                    const Vec3 x1 = g.to_world(p1) * units::kMetresPerMm, x2 = g.to_world(p2) * units::kMetresPerMm;
+                    Vec3 area = 0.5 * (x1 - face.centre_m).cross(x2 - face.centre_m);
+                    if (area.dot(face.area_m2) < 0) area = -area;
+                    const int kt = lattice::tet_holding(cube_local(centroid, a, b, c, L), odd);
                     Accum& ac = acc[p][kt];
                     ac.tet = first_tet[p][q] + kt;
-                    const auto& tv = m.tets[ac.tet];
-                    const Vec3& X0 = m.rest_m[tv[0]];
-                    Mat3 dm;
-                    dm << m.rest_m[tv[1]] - X0, m.rest_m[tv[2]] - X0, m.rest_m[tv[3]] - X0;
-                    const Vec3 wts = dm.inverse() * (g.to_world(centroid) * units::kMetresPerMm - X0);
-                    const double w4[4] = {1.0 - wts.sum(), wts[0], wts[1], wts[2]};
+                    const auto w4 = rest_barycentric(m, ac.tet, g.to_world(centroid) * units::kMetresPerMm);
                     for (int v = 0; v < 4; ++v) ac.b[v] += w4[v] * area;
                   }
                   ++acc[p][0].faces;   // counted once per face, whichever tetrahedra carry it
@@ -283,7 +296,6 @@ void build_bone_obstacles(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
   auto viscera_cube = [&](int64_t i, int64_t j, int64_t k) {
     return near_viscera[lat.cube_index(i / L, j / L, k / L)] != 0;
   };
-  const double mm2_to_m2 = units::kMetresPerMm * units::kMetresPerMm;
   for (int64_t k = 0; k < g.dims[2]; ++k)
     for (int64_t j = 0; j < g.dims[1]; ++j)
       for (int64_t i = 0; i < g.dims[0]; ++i) {
@@ -296,17 +308,9 @@ void build_bone_obstacles(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
             const Role beyond = roles.role[g.linear_index(n[0], n[1], n[2])];
             if (beyond == Role::Fixed || beyond == Role::Wall) continue;
             if (!viscera_cube(i, j, k)) continue;
-            Vec3 centre = Vec3(double(i), double(j), double(k)), du = Vec3::Zero(), dw = Vec3::Zero();
-            centre[axis] += 0.5 * side;
-            du[(axis + 1) % 3] = 1.0;
-            dw[(axis + 2) % 3] = 1.0;
-            const Vec3 c = g.to_world(centre);
-            Vec3 area = (g.to_world(centre + du) - c).cross(g.to_world(centre + dw) - c) * mm2_to_m2;
-            const Vec3 out = g.to_world(Vec3(double(n[0]), double(n[1]), double(n[2]))) -
-                             g.to_world(Vec3(double(i), double(j), double(k)));
-            if (area.dot(out) < 0) area = -area;
-            m.contact.fixed_centre_m.push_back(c * units::kMetresPerMm);
-            m.contact.fixed_area_m2.push_back(area);
+            const VoxelFace face = voxel_face(g, i, j, k, axis, side);   // out of the bone
+            m.contact.fixed_centre_m.push_back(face.centre_m);
+            m.contact.fixed_area_m2.push_back(face.area_m2);
           }
       }
 }

@@ -3,13 +3,6 @@
 
 namespace pneumo {
 
-namespace {
-/// cof(D_s)·c for the edges e_k = x_k − x_0: c.x (e2×e3) + c.y (e3×e1) + c.z (e1×e2).
-Vec3 cofactor_times(const Vec3& e1, const Vec3& e2, const Vec3& e3, const Vec3& c) {
-  return c[0] * e2.cross(e3) + c[1] * e3.cross(e1) + c[2] * e1.cross(e2);
-}
-}  // namespace
-
 std::array<Vec3, 4> pressure_load_forces(const Mesh& m, int64_t l, const std::vector<Vec3>& x, double pressure_pa) {
   const auto& q = m.tets[m.load_tet[l]];
   const Vec3 e1 = x[q[1]] - x[q[0]], e2 = x[q[2]] - x[q[0]], e3 = x[q[3]] - x[q[0]];
