@@ -20,6 +20,11 @@ enum class MaterialModel : uint8_t { Msd, FemCorotational, FemNeoHookean };
 enum class RampShape : uint8_t { Smooth, Linear };
 enum class SolverMethod : uint8_t { Static, Explicit, Newmark, Kitasaka2004, Newton, ImplicitEuler };
 enum class OnInverted : uint8_t { Continue, Stop };
+/// The solvers that take any force field (solve/force_field.h), which the finite elements and contact
+/// need; the explicit schemes and the 2004 scheme call the springs' evaluator directly.
+inline bool solves_force_fields(SolverMethod m) {
+  return m == SolverMethod::Static || m == SolverMethod::Newton || m == SolverMethod::ImplicitEuler;
+}
 enum class Lens : uint8_t { Pinhole, Fisheye };
 enum class RenderPreset : uint8_t { Laparoscopic, CtSoftTissue, CtMuscle, CtAaa, CtAir, Custom };
 /// Speed against accuracy (scene_presets.h): what `pneumo bench` measured each to buy.

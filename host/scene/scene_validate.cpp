@@ -60,8 +60,7 @@ void check_material_model(const Scene& s, const At& root) {
   const SceneMaterial& m = s.material;
   // The contact term lives in the force fields (solve/contact.h); the explicit schemes and the 2004
   // scheme call the springs' evaluator directly.
-  if (m.contact && s.solver.method != SolverMethod::Newton && s.solver.method != SolverMethod::Static &&
-      s.solver.method != SolverMethod::ImplicitEuler)
+  if (m.contact && !solves_force_fields(s.solver.method))
     root.child("solver").child("method").fail_value(enum_name(s.solver.method),
                                                     "cannot solve with material.contact; use \"newton\", \"static\" "
                                                     "or \"implicit-euler\", or set contact to false");
@@ -70,8 +69,7 @@ void check_material_model(const Scene& s, const At& root) {
   if (m.model == MaterialModel::Msd) return;
   // The explicit schemes need the springs' dampers and stable step, the 2004 scheme their stiffness
   // sums; the finite elements have neither (docs/fem.md). Implicit Euler damps by Rayleigh's C.
-  if (s.solver.method != SolverMethod::Newton && s.solver.method != SolverMethod::Static &&
-      s.solver.method != SolverMethod::ImplicitEuler)
+  if (!solves_force_fields(s.solver.method))
     root.child("solver").child("method").fail_value(enum_name(s.solver.method),
                                                     std::string("cannot solve material.model \"") + enum_name(m.model) +
                                                         "\"; use \"newton\", \"static\" or \"implicit-euler\"");

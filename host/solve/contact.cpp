@@ -13,9 +13,17 @@ namespace {
 /// cof(D_s)·c for the tetrahedron's edges at x: the face's deformed area vector (mesh.h).
 Vec3 deformed_area(const Mesh& m, int32_t face, const std::vector<Vec3>& x) {
   const auto& q = m.tets[m.contact.tet[face]];
-  const Vec3 e1 = x[q[1]] - x[q[0]], e2 = x[q[2]] - x[q[0]], e3 = x[q[3]] - x[q[0]];
-  const Vec3& c = m.contact.c[face];
-  return c[0] * e2.cross(e3) + c[1] * e3.cross(e1) + c[2] * e1.cross(e2);
+  return cofactor_times(x[q[1]] - x[q[0]], x[q[2]] - x[q[0]], x[q[3]] - x[q[0]], m.contact.c[face]);
+}
+
+/// out += w·v on the slave's vertices and −w·v on the master's (none for bone): how a force along the
+/// pair, or a stiffness product, reaches the nodes.
+void spread(const Mesh& m, const ContactPair& p, const Vec3& v, std::vector<Vec3>& out) {
+  const auto& qs = m.tets[m.contact.tet[p.slave]];
+  for (int i = 0; i < 4; ++i) out[qs[i]] += m.contact.w[p.slave][i] * v;
+  if (p.master < 0) return;
+  const auto& qm = m.tets[m.contact.tet[p.master]];
+  for (int i = 0; i < 4; ++i) out[qm[i]] -= m.contact.w[p.master][i] * v;
 }
 
 Vec3 embedded_point(const Mesh& m, int32_t face, const std::vector<Vec3>& x) {
@@ -200,12 +208,7 @@ void add_contact_forces(const Mesh& m, const std::vector<ContactPair>& pairs, co
   for (const ContactPair& p : pairs) {
     const double gap = contact_offset(m, p, x).dot(p.normal);
     if (!(gap < 0.0)) continue;
-    const Vec3 push = -p.stiffness_n_per_m * gap * p.normal;   // on the slave, out of the master
-    const auto& qs = m.tets[m.contact.tet[p.slave]];
-    for (int i = 0; i < 4; ++i) f[qs[i]] += m.contact.w[p.slave][i] * push;
-    if (p.master < 0) continue;
-    const auto& qm = m.tets[m.contact.tet[p.master]];
-    for (int i = 0; i < 4; ++i) f[qm[i]] -= m.contact.w[p.master][i] * push;
+    spread(m, p, -p.stiffness_n_per_m * gap * p.normal, f);   // on the slave, out of the master
   }
 }
 
@@ -229,21 +232,22 @@ class ContactForceField final : public ForceField {
   void evaluate(const ForceModel& model, const std::vector<Vec3>& x, const std::vector<Vec3>& v,
                 std::vector<Vec3>& f) override {
     inner_->evaluate(model, x, v, f);
-    add_contact_forces(m_, search_.find(x), x, f);
+    add_contact_forces(m_, pairs_at(x), x, f);
   }
 
   double elastic_energy(const ForceModel& model, const std::vector<Vec3>& x) override {
-    return inner_->elastic_energy(model, x) + contact_energy(m_, search_.find(x), x);
+    return inner_->elastic_energy(model, x) + contact_energy(m_, pairs_at(x), x);
   }
 
   void linearize(const ForceModel& model, const std::vector<Vec3>& x) override {
     inner_->linearize(model, x);
-    pairs_ = search_.find(x);
+    pairs_ = pairs_at(x);
   }
 
   void stiffness_product(const std::vector<Vec3>& p, std::vector<Vec3>& kp) override {
     inner_->stiffness_product(p, kp);
-    for (const ContactPair& c : pairs_) add(c, c.stiffness_n_per_m * relative_motion(m_, c, p).dot(c.normal), kp);
+    for (const ContactPair& c : pairs_)
+      spread(m_, c, c.stiffness_n_per_m * relative_motion(m_, c, p).dot(c.normal) * c.normal, kp);
   }
 
   void stiffness_diagonal(std::vector<Mat3>& blocks) override {
@@ -276,19 +280,22 @@ class ContactForceField final : public ForceField {
   int64_t evaluations() const override { return inner_->evaluations(); }
 
  private:
-  /// kp += t·n on the slave's vertices (by weight) and −t·n on the master's.
-  void add(const ContactPair& c, double t, std::vector<Vec3>& kp) const {
-    const auto& qs = m_.tets[m_.contact.tet[c.slave]];
-    for (int i = 0; i < 4; ++i) kp[qs[i]] += m_.contact.w[c.slave][i] * t * c.normal;
-    if (c.master < 0) return;
-    const auto& qm = m_.tets[m_.contact.tet[c.master]];
-    for (int i = 0; i < 4; ++i) kp[qm[i]] -= m_.contact.w[c.master][i] * t * c.normal;
+  /// The pairs at x, searched again only when x is not the state last searched: Newton linearises at
+  /// the trial it has just evaluated, so one search serves both.
+  const std::vector<ContactPair>& pairs_at(const std::vector<Vec3>& x) {
+    if (x != searched_x_) {
+      searched_ = search_.find(x);
+      searched_x_ = x;
+    }
+    return searched_;
   }
 
   const Mesh& m_;
   ContactSearch search_;
   std::unique_ptr<ForceField> inner_;
-  std::vector<ContactPair> pairs_;
+  std::vector<ContactPair> pairs_;                  // at the last linearisation
+  std::vector<ContactPair> searched_;               // at searched_x_
+  std::vector<Vec3> searched_x_;
 };
 
 }  // namespace

@@ -76,9 +76,7 @@ SolveOptions solve_options_from_scene(const Scene& s) {
 
 SolveResult solve(const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x_start) {
   std::vector<Vec3> x = x_start.empty() ? m.rest_m : x_start;
-  const bool field_solver = opt.method == SolverMethod::Static || opt.method == SolverMethod::Newton ||
-                            opt.method == SolverMethod::ImplicitEuler;
-  if (opt.forces.contact_stiffness > 0.0 && !field_solver)
+  if (opt.forces.contact_stiffness > 0.0 && !solves_force_fields(opt.method))
     throw InputError(std::string("contact needs solver.method \"static\", \"newton\" or \"implicit-euler\", not \"") +
                      enum_name(opt.method) + "\"");
   switch (opt.method) {
