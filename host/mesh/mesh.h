@@ -136,6 +136,13 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const std::func
 /// u = x − x₀ per node (metres): what deformation.bin, checkpoints and the warp carry.
 std::vector<Vec3> displacements(const Mesh& m, const std::vector<Vec3>& x);
 
+/// The same mesh with rest shape `rest_m` (one position per node, metres): the springs' rest lengths and the
+/// tetrahedra's rest volumes follow it; the material (masses, stiffnesses, dampers, moduli) and the
+/// embedded faces stay. An embedded face keeps its barycentric weights and its c = cof(D_m)⁻¹ N dA,
+/// which is the face's area vector in the tetrahedron's own frame, the same in every rest shape the
+/// tissue maps to (Nanson). Throws std::runtime_error when a tetrahedron would be inside out.
+Mesh with_rest_shape(const Mesh& m, const std::vector<Vec3>& rest_m);
+
 /// The mesh of a scene's roles, with its material assigned.
 Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene);
 

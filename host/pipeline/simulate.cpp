@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "core/atomic_file.h"
@@ -15,6 +16,7 @@
 #include "mesh/deformation_file.h"
 #include "mesh/vtu_writer.h"
 #include "report/plot_svg.h"
+#include "solve/gravity_compensation.h"
 #include "solve/solvable.h"
 #include "solve/solve_on_device.h"
 
@@ -77,10 +79,21 @@ void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hoo
   } else {
     sim.device = "cpu";
   }
-  auto run = [&](const SolveOptions& opt, const std::vector<Vec3>& x_start) {
-    return solve_on_device(ctx.get(), sim.mesh, opt, x_start);
-  };
   SolveOptions base = solve_options_from_scene(scene);
+  // With gravity compensated the solver's rest shape is the unloaded one, and every solve starts at
+  // the CT (its equilibrium under gravity); displacements stay measured from the CT (sim.mesh).
+  std::optional<Mesh> unloaded;
+  if (scene.material.gravity && scene.material.gravity_compensation) {
+    UnloadedShape u = unloaded_shape(sim.mesh, base, [&](const Mesh& m, const SolveOptions& o, const std::vector<Vec3>& xs) {
+      return solve_on_device(ctx.get(), m, o, xs);
+    });
+    sim.gravity = {true, u.sag_mm, u.error_mm, u.wall_time_s, u.iterations, u.solver_steps};
+    unloaded = std::move(u.mesh);
+  }
+  const Mesh& solver_mesh = unloaded ? *unloaded : sim.mesh;
+  auto run = [&](const SolveOptions& opt, const std::vector<Vec3>& x_start) {
+    return solve_on_device(ctx.get(), solver_mesh, opt, x_start.empty() ? sim.mesh.rest_m : x_start);
+  };
   base.snapshot_every_steps = hooks.snapshot_every_steps;
   base.on_snapshot = hooks.on_snapshot;
   if (scene.load.pressure_curve_mmhg.empty()) {
@@ -129,6 +142,14 @@ void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hoo
     }
   }
   sim.stage_seconds_solve = seconds_since(t0);
+  // Gravity without contact: where the gas does not carry the wall's weight (below about 2-3 mmHg) the
+  // wall sinks into the viscera it lies on, and the "cavity" closes below zero. Said, not hidden.
+  if (scene.material.gravity && !scene.material.contact) {
+    const double ml = deformation_metrics(sim.mesh, sim.result.x).cavity_volume_ml;
+    if (ml < 0.0)
+      log::warn("the cavity closed to " + std::to_string(int(ml)) + " ml: the pressure does not carry the wall's "
+                "weight and the wall sank into the viscera; raise load.pressure_mmhg or set material.contact to true");
+  }
 }
 
 DeformationMetrics deformation_metrics(const Mesh& m, const std::vector<Vec3>& x) {
@@ -201,6 +222,10 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   j["max_fixed_displacement_mm"] = d.max_fixed_displacement_mm;
   j["cavity_volume_ml"] = d.cavity_volume_ml;
   j["inverted_tetrahedra"] = r.inverted_tetrahedra;
+  if (sim.gravity.done)
+    j["gravity_compensation"] = {{"sag_mm", sim.gravity.sag_mm}, {"error_mm", sim.gravity.error_mm},
+                                 {"solves", sim.gravity.iterations}, {"steps", sim.gravity.solver_steps},
+                                 {"wall_time_s", sim.gravity.wall_time_s}};
   j["roles_ml"] = {{"wall", sim.roles.volume_ml(Role::Wall)},
                    {"viscera", sim.roles.volume_ml(Role::Viscera)},
                    {"fixed", sim.roles.volume_ml(Role::Fixed)}};

@@ -18,9 +18,18 @@ struct PressurePoint {
   int64_t steps = 0;
 };
 
+/// What gravity compensation found (solve/gravity_compensation.h), when it ran.
+struct GravityCompensation {
+  bool done = false;
+  double sag_mm = 0, error_mm = 0, wall_time_s = 0;
+  int iterations = 0;
+  int64_t solver_steps = 0;
+};
+
 struct Simulation {
   RoleVolume roles;
-  Mesh mesh;
+  Mesh mesh;                                  // at the CT's shape: displacements are from it
+  GravityCompensation gravity;
   SolveResult result;                         // at the scene's load.pressure_mmhg
   std::vector<PressurePoint> pressure_curve;  // when the scene lists pressures (§9), in order
   std::string device;   // "cpu" or "opencl:P:D <name>"

@@ -80,6 +80,7 @@ struct SceneMaterial {
   double stiffening = 0.0;        // b of the exponential spring law (solve/forces.h); 0 = linear
   std::optional<double> volume_stiffness_kpa;          // unset: see effective_volume_stiffness_kpa()
   bool gravity = false;           // the CT already shows the body under gravity (§5)
+  bool gravity_compensation = true;   // solve from the unloaded shape whose weight gives the CT (Bano 2012)
   double tilt_deg = 0.0;          // table tilt about the left-right axis: > 0 head down (Trendelenburg)
   bool contact = false;           // viscera kept out of wall and bone (solve/contact.h)
   double contact_stiffness = 10.0;   // κ: contact k = κ E / cube edge (solve/contact.h)

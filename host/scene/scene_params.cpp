@@ -188,6 +188,10 @@ const Table<SceneMaterial>& material_table() {
        "other solvers."},
       {"gravity", &SceneMaterial::gravity, "", any(),
        "Apply gravity (9.81 m/s², towards posterior: supine). The CT already shows the body under gravity (§5)."},
+      {"gravity_compensation", &SceneMaterial::gravity_compensation, "", any(),
+       "With gravity: solve from the unloaded shape whose equilibrium under gravity is the CT (Bano 2012, iterated "
+       "to 1 % of the sag), so the weight the CT already shows is not applied twice; false = gravity sags the CT's "
+       "own shape (solve/gravity_compensation.h)."},
       {"tilt_deg", &SceneMaterial::tilt_deg, "deg", in(-45, 45),
        "Table tilt about the left-right axis with gravity on: > 0 head down (Trendelenburg, 15-30 in pelvic "
        "surgery), < 0 head up (reverse Trendelenburg, upper abdomen); gravity then has 9.81·sin(tilt) towards the "

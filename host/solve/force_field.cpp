@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "solve/contact.h"
+#include "solve/interface_tie.h"
 
 namespace pneumo {
 
@@ -19,7 +20,7 @@ std::unique_ptr<ForceField> make_material_field(const Mesh& m, const ForceModel&
 }  // namespace
 
 std::unique_ptr<ForceField> make_force_field(const Mesh& m, const ForceModel& model) {
-  return with_contact(m, model, make_material_field(m, model));
+  return with_interface_tie(m, model, with_contact(m, model, make_material_field(m, model)));
 }
 
 }  // namespace pneumo

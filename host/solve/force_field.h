@@ -41,7 +41,8 @@ class ForceField {
   virtual int64_t evaluations() const = 0;
 };
 
-/// The force field of `model.material` on mesh m, with the contact term when model.contact_stiffness > 0.
+/// The force field of `model.material` on mesh m, with the contact term when model.contact_stiffness > 0
+/// and the wall-viscera bond when model.tie_interface.
 std::unique_ptr<ForceField> make_force_field(const Mesh& m, const ForceModel& model);
 
 /// The implementations (what make_force_field picks from).

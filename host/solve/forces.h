@@ -18,6 +18,7 @@ struct ForceModel {
   double volume_stiffness_pa = 0.0;    // Kitasaka's k_v; 0 = off
   Vec3 gravity_m_s2 = Vec3::Zero();    // option (Bano); zero = off
   double contact_stiffness = 0.0;      // κ of the viscera's contact with wall and bone (contact.h); 0 = off
+  bool tie_interface = false;          // wall bonded to viscera where they touch at rest (interface_tie.h)
   double stiffening = 0.0;             // b of the exponential spring law (stiffened_strain), or of
                                        // Demiray's law for fem-neohookean; 0 = linear / neo-Hookean
 };

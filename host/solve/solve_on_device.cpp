@@ -6,6 +6,7 @@
 #include "solve/contact.h"
 #include "solve/fem_force_field_cl.h"
 #include "solve/force_field.h"
+#include "solve/interface_tie.h"
 #include "solve/solver_cl.h"
 
 namespace pneumo {
@@ -13,7 +14,8 @@ namespace pneumo {
 bool device_implements(const SolveOptions& opt) {
   const bool fem = opt.forces.material != MaterialModel::Msd;
   if (opt.method == SolverMethod::ImplicitEuler) return false;
-  if (opt.forces.contact_stiffness > 0.0 && !fem) return false;   // the springs' device schemes have no contact
+  // The springs' device schemes have no contact and no interface bond.
+  if ((opt.forces.contact_stiffness > 0.0 || opt.forces.tie_interface) && !fem) return false;
   return opt.method == SolverMethod::Newton ? fem : !fem;
 }
 
@@ -22,7 +24,7 @@ SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions
   if (ctx && device_implements(opt)) {
     if (opt.method != SolverMethod::Newton) return solve_opencl(*ctx, m, opt, x_start);
     const std::unique_ptr<ForceField> field =
-        with_contact(m, opt.forces, make_fem_force_field_cl(*ctx, m, opt.forces.material));
+        with_interface_tie(m, opt.forces, with_contact(m, opt.forces, make_fem_force_field_cl(*ctx, m, opt.forces.material)));
     return solve_newton_on(m, opt, *field, x_start);
   }
   if (ctx) {

@@ -91,8 +91,11 @@ Monitor::Monitor(const Mesh& m, const SolveOptions& opt, const std::string& solv
     : m_(m), opt_(opt), r_(r), start_(std::chrono::steady_clock::now()), progress_("solve " + solver, 0) {
   r.solver = solver;
   check_solvable(m, opt);   // nothing free, or a part the load would carry away: no solver can answer
-  // Reference load: the pressure's largest nodal force at rest.
-  const std::vector<Vec3> f = pressure_forces(m, m.rest_m, opt.forces.pressure_pa);
+  // Reference load: the largest nodal force of the pressure and gravity at rest (gravity alone when
+  // the unloaded shape is sought, gravity_compensation.h).
+  std::vector<Vec3> f = pressure_forces(m, m.rest_m, opt.forces.pressure_pa);
+  if (!m.mass_kg.empty())
+    for (int64_t n = 0; n < m.node_count(); ++n) f[n] += m.mass_kg[n] * opt.forces.gravity_m_s2;
   double ref = 0.0;
   for (const auto& v : f) ref = std::max(ref, v.norm());
   if (!(ref > 0.0)) {

@@ -1,0 +1,34 @@
+#pragma once
+// The wall bonded to the viscera where they touch at rest, for the one state in which no gas
+// separates them: the CT itself, carrying its weight (gravity_compensation.h). The wall and the
+// viscera are separate meshes, doubled where they touch (mesh.h), so without a bond gravity lets the
+// wall fall through the viscera it lies on (on the real CT, 36 mm and −644 ml of "cavity" under
+// gravity alone) and the unloaded shape would be lifted by that fall.
+//
+// Each wall node and the viscera node at the same lattice point form a pair, held by a linear spring
+// of zero length relative to their rest offset: energy ½ k |(x_w − x_v) − (X_w − X_v)|². k is κ = 10
+// times the stiffer node's own spring stiffness (Σ over its tetrahedra of Lloyd's k for their modulus
+// and volume, mesh.h), so the pair slips by a tenth of what the tissue next to it deforms under the
+// same force.
+#include <memory>
+#include <vector>
+
+#include "mesh/mesh.h"
+
+namespace pneumo {
+
+class ForceField;
+struct ForceModel;
+
+struct TiedPair {
+  int32_t wall = 0, viscera = 0;
+  double stiffness_n_per_m = 0;
+};
+
+/// The coincident wall/viscera node pairs of m and their bond stiffness.
+std::vector<TiedPair> interface_pairs(const Mesh& m);
+
+/// `inner` with the bond added when model.tie_interface is set and m has pairs; `inner` otherwise.
+std::unique_ptr<ForceField> with_interface_tie(const Mesh& m, const ForceModel& model, std::unique_ptr<ForceField> inner);
+
+}  // namespace pneumo
