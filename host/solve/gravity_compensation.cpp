@@ -1,7 +1,10 @@
 #include "solve/gravity_compensation.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 
 #include "core/log.h"
@@ -62,7 +65,7 @@ UnloadedShape unloaded_shape(const Mesh& ct, const SolveOptions& opt, const Stat
     u.error_mm = units::m_to_mm(error);
     log::info("gravity compensation, step " + std::to_string(k + 1) + ": the CT shape is missed by " + mm(error) +
               " (sag " + mm(units::kMetresPerMm * u.sag_mm) + ")");
-    if (error <= kSagFraction * units::kMetresPerMm * u.sag_mm || error == 0.0) {
+    if (error <= kSagFraction * units::kMetresPerMm * u.sag_mm) {
       u.wall_time_s = seconds_since(t0);
       return u;
     }
