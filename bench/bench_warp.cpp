@@ -96,7 +96,7 @@ const WarpCase& warp_case() {
   std::fprintf(stderr, "[bench_warp] large phantom: %lldx%lldx%lld output voxels, %lld tetrahedra, solved (%s) in "
                        "%lld steps; set up in %.0f s\n",
                (long long)c->box.dims[0], (long long)c->box.dims[1], (long long)c->box.dims[2],
-               (long long)c->mesh.tet_count(), r.stop_reason.c_str(), (long long)r.steps,
+               (long long)c->mesh.tet_count(), stop_reason_text(r.stop_reason), (long long)r.steps,
                std::chrono::duration<double>(Clock::now() - t0).count());
   return *c;
 }

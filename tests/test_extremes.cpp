@@ -224,7 +224,7 @@ TEST(ExtremeMaterial, YoungFrom1kPaTo1MPa) {
     ASSERT_TRUE(all_finite(r.x));
     EXPECT_TRUE(r.converged) << r.stop_reason;
     EXPECT_EQ(r.inverted_tetrahedra, 0);
-    std::printf("E = %6.0f kPa: %s after %lld steps, lift %.4f mm\n", young_kpa, r.stop_reason.c_str(),
+    std::printf("E = %6.0f kPa: %s after %lld steps, lift %.4f mm\n", young_kpa, stop_reason_text(r.stop_reason),
                 (long long)r.steps, units::m_to_mm(lift(m, r.x)));
     if (young_kpa == 100.0) lift_times_e_100 = lift(m, r.x) * young_kpa;
     if (young_kpa == 1000.0) {
@@ -279,11 +279,11 @@ TEST(ExtremeDamping, ZetaZeroNeverSettlesZetaTwoDoes) {
   o.max_steps = 20000;
   const SolveResult a = solve(undamped, o);
   EXPECT_FALSE(a.converged);
-  EXPECT_EQ(a.stop_reason, "step limit");
+  EXPECT_EQ(a.stop_reason, StopReason::StepLimit);
   EXPECT_EQ(a.steps, o.max_steps);
   EXPECT_TRUE(all_finite(a.x));
   const SolveResult b = solve(overdamped, o);
-  std::printf("zeta = 2: %s after %lld steps\n", b.stop_reason.c_str(), (long long)b.steps);
+  std::printf("zeta = 2: %s after %lld steps\n", stop_reason_text(b.stop_reason), (long long)b.steps);
   EXPECT_TRUE(b.converged) << b.stop_reason;
   EXPECT_TRUE(all_finite(b.x));
   EXPECT_EQ(solve(undamped, quiet(SolverMethod::Static, 10.0)).x, solve(overdamped, quiet(SolverMethod::Static, 10.0)).x);
@@ -472,7 +472,7 @@ TEST(ExtremeInversion, InvertedTetrahedraAreCountedReportedAndStopTheRunWhenAske
     SolveOptions s = quiet(method, 12.0);
     s.on_inverted = OnInverted::Stop;
     const SolveResult stopped = solve(m, s);
-    EXPECT_EQ(stopped.stop_reason, "inverted tetrahedra");
+    EXPECT_EQ(stopped.stop_reason, StopReason::InvertedTetrahedra);
     EXPECT_FALSE(stopped.converged);
     expect_inversions_reported(m, stopped, nullptr);
     if (method == SolverMethod::Static) {
@@ -509,18 +509,18 @@ TEST_P(ExtremeInversionOn, TheSoftSlabInvertsAndTheRunStopsOrGoesOnAsTold) {
     return ctx ? solve_opencl(*ctx, m, o) : solve(m, o);
   };
   const SolveResult stopped = run(OnInverted::Stop, 100000);
-  EXPECT_EQ(stopped.stop_reason, "inverted tetrahedra");
+  EXPECT_EQ(stopped.stop_reason, StopReason::InvertedTetrahedra);
   EXPECT_FALSE(stopped.converged);
   expect_inversions_reported(m, stopped, nullptr);
   ::testing::internal::CaptureStderr();
   const SolveResult went_on = run(OnInverted::Continue, 2 * stopped.steps);
   const std::string log = ::testing::internal::GetCapturedStderr();
-  EXPECT_NE(went_on.stop_reason, "inverted tetrahedra");
+  EXPECT_NE(went_on.stop_reason, StopReason::InvertedTetrahedra);
   EXPECT_GT(went_on.steps, stopped.steps);
   expect_inversions_reported(m, went_on, &log);
   std::printf("%s on %s: stopped after %lld steps with %lld inverted; continue: %s after %lld steps, %lld inverted\n",
               enum_name(method), device.c_str(), (long long)stopped.steps, (long long)stopped.inverted_tetrahedra,
-              went_on.stop_reason.c_str(), (long long)went_on.steps, (long long)went_on.inverted_tetrahedra);
+              stop_reason_text(went_on.stop_reason), (long long)went_on.steps, (long long)went_on.inverted_tetrahedra);
 }
 
 INSTANTIATE_TEST_SUITE_P(EverySolver, ExtremeInversionOn,

@@ -90,7 +90,7 @@ json real_ct_row(BenchCase& c, int cube_voxels, SolverMethod method, double limi
     const DeformationMetrics d = deformation_metrics(c.mesh, r.x);
     row["wall_s"] = seconds_since(t0);
     row["converged"] = r.converged;
-    row["stop_reason"] = r.stop_reason;
+    row["stop_reason"] = stop_reason_text(r.stop_reason);
     row["steps"] = r.steps;
     row["inner_iterations"] = r.inner_iterations;
     row["inverted_tetrahedra"] = r.inverted_tetrahedra;

@@ -240,7 +240,7 @@ json measure_speed_accuracy(BenchContext& ctx) {
     if (!s.timed_out && s.error.empty()) {
       r["steps"] = s.result.steps;
       r["force_evaluations"] = s.result.force_evaluations;
-      r["stop_reason"] = s.result.stop_reason;
+      r["stop_reason"] = stop_reason_text(s.result.stop_reason);
       r["residual"] = s.result.residual;
       const MappedPoints mp = map_points(points, c.roles, c.mesh, s.result.x);
       const PointError skin = compare_points(mp.skin_mm, mp.skin_ok, ref_points.skin_mm, ref_points.skin_ok);

@@ -247,7 +247,7 @@ json measure_case_throughput(BenchContext& ctx, const BenchCase& c, int pipeline
         render_s.push_back(frame);
         total_s.push_back(solve_s.back() + warp_s.back() + frame);
         solve_info = {{"steps", r.steps}, {"force_evaluations", r.force_evaluations}, {"converged", r.converged},
-                      {"stop_reason", r.stop_reason}, {"residual", r.residual}};
+                      {"stop_reason", stop_reason_text(r.stop_reason)}, {"residual", r.residual}};
         last_warp = std::move(w);
       }
       const Summary solve = summarize(solve_s), warp = summarize(warp_s);

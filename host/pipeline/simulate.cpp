@@ -27,7 +27,7 @@ namespace {
 const Vec3 kAnterior(0.0, 1.0, 0.0);
 
 void throw_if_stopped_inverted(const SolveResult& r, const Mesh& m, double target_mmhg) {
-  if (r.stop_reason != "inverted tetrahedra") return;
+  if (r.stop_reason != StopReason::InvertedTetrahedra) return;
   char at[96];
   std::snprintf(at, sizeof at, "at step %lld (%.1f of %.1f mmHg)", (long long)r.steps,
                 r.final_pressure_pa / units::kPaPerMmHg, target_mmhg);
@@ -137,7 +137,7 @@ void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hoo
       sim.result.x = sim.mesh.rest_m;
       sim.result.v.assign(sim.mesh.rest_m.size(), Vec3::Zero());
       sim.result.converged = true;
-      sim.result.stop_reason = "converged";
+      sim.result.stop_reason = StopReason::Converged;
       sim.result.solver = enum_name(base.method);
     }
   }
@@ -194,7 +194,7 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   j["scene"] = scene.path;
   j["device"] = sim.device;
   j["converged"] = r.converged;
-  j["stop_reason"] = r.stop_reason;
+  j["stop_reason"] = stop_reason_text(r.stop_reason);
   j["solver"] = r.solver;
   j["pressure_mmhg"] = r.final_pressure_pa / units::kPaPerMmHg;
   j["cube_voxels"] = sim.mesh.cube_voxels;

@@ -55,7 +55,7 @@ UnloadedShape unloaded_shape(const Mesh& ct, const SolveOptions& opt, const Stat
     ++u.iterations;
     u.solver_steps += r.steps;
     if (!r.converged)
-      throw std::runtime_error("gravity compensation: the solve under gravity alone stopped (" + r.stop_reason +
+      throw std::runtime_error("gravity compensation: the solve under gravity alone stopped (" + std::string(stop_reason_text(r.stop_reason)) +
                                ", residual " + std::to_string(r.residual) +
                                "): the body does not carry its own weight; check the fixed roles "
                                "(roles.fixed_labels), raise material.young_kpa, or set material.gravity_compensation "

@@ -15,7 +15,7 @@ SolveResult solve_explicit(const Mesh& m, const SolveOptions& opt, std::vector<V
   const std::string advice = detail::dt_advice(dt, r.dt_stable_s);
   int64_t step = 0;
   double residual = INFINITY;
-  std::string reason;
+  std::optional<StopReason> reason;   // none: go on
   while (step < opt.max_steps) {
     const double t = step * dt;
     model.pressure_pa = detail::ramped_pressure(opt, t);
@@ -25,10 +25,10 @@ SolveResult solve_explicit(const Mesh& m, const SolveOptions& opt, std::vector<V
     for (int64_t n = 0; n < m.node_count(); ++n) x[n] += dt * v[n];
     ++step;
     reason = mon.check_dynamic(step, t + dt, model.pressure_pa, f, x, v, advice, &residual);
-    if (!reason.empty()) break;
+    if (reason) break;
   }
   r.final_pressure_pa = model.pressure_pa;
-  mon.finish(x, v, step, eval.evaluations(), reason == "converged", reason.empty() ? "step limit" : reason, residual);
+  mon.finish(x, v, step, eval.evaluations(), reason.value_or(StopReason::StepLimit), residual);
   return r;
 }
 

@@ -48,7 +48,7 @@ SolveResult solve_implicit_euler(const Mesh& m, const SolveOptions& opt, std::ve
   int64_t step = 0, cg_iterations = 0;
   double residual = INFINITY;
   Shift shift;
-  std::string reason;
+  std::optional<StopReason> reason;   // none: go on
   const double k_scale = h * (h + beta);
   while (step < opt.max_steps) {
     const double t = step * h;
@@ -77,11 +77,11 @@ SolveResult solve_implicit_euler(const Mesh& m, const SolveOptions& opt, std::ve
     for (int64_t n = 0; n < N; ++n) x[n] += h * v[n];
     ++step;
     reason = mon.check_dynamic(step, t + h, model.pressure_pa, f, x, v, advice, &residual);
-    if (!reason.empty()) break;
+    if (reason) break;
   }
   r.final_pressure_pa = model.pressure_pa;
   r.inner_iterations = cg_iterations;
-  mon.finish(x, v, step, field->evaluations(), reason == "converged", reason.empty() ? "step limit" : reason, residual);
+  mon.finish(x, v, step, field->evaluations(), reason.value_or(StopReason::StepLimit), residual);
   return r;
 }
 

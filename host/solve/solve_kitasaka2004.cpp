@@ -51,8 +51,7 @@ SolveResult solve_kitasaka2004(const Mesh& m, const SolveOptions& opt, std::vect
   std::vector<Vec3> f;
   int64_t step = 0;
   double residual = INFINITY, moved = INFINITY;
-  bool converged = false;
-  std::string reason = "step limit";
+  StopReason reason = StopReason::StepLimit;
   const std::string advice = detail::kKitasakaAdvice;
   bool f_is_current = false;   // f holds the forces at x (the monitor just evaluated them)
   while (step < opt.max_steps) {
@@ -75,15 +74,15 @@ SolveResult solve_kitasaka2004(const Mesh& m, const SolveOptions& opt, std::vect
       eval.evaluate(model, x, {}, f);
       f_is_current = true;
       residual = mon.residual(f);
-      if (mon.record(step, 0.0, model.pressure_pa, residual, x, {})) { reason = "inverted tetrahedra"; break; }
-      if (done) { converged = true; reason = "converged"; break; }
+      if (mon.record(step, 0.0, model.pressure_pa, residual, x, {})) { reason = StopReason::InvertedTetrahedra; break; }
+      if (done) { reason = StopReason::Converged; break; }
     }
   }
   r.final_pressure_pa = model.pressure_pa;
   // A Gauss-Seidel sweep evaluates every node's force once, outside `eval`: count it as one force evaluation.
   // Jacobi sweeps evaluate through `eval`, which counts them already.
   const int64_t sweeps_outside_eval = opt.kitasaka_jacobi ? 0 : step;
-  mon.finish(x, {}, step, sweeps_outside_eval + eval.evaluations(), converged, reason, residual);
+  mon.finish(x, {}, step, sweeps_outside_eval + eval.evaluations(), reason, residual);
   return r;
 }
 

@@ -33,7 +33,7 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
   const std::string advice = detail::dt_advice(dt, r.dt_stable_s);
   int64_t step = 0;
   double residual = INFINITY;
-  std::string reason;
+  std::optional<StopReason> reason;   // none: go on
   while (step < opt.max_steps) {
     const double t_next = (step + 1) * dt;
     model.pressure_pa = detail::ramped_pressure(opt, t_next);
@@ -67,10 +67,10 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
     detail::apply_holds(m, v);
     ++step;
     reason = mon.check_dynamic(step, t_next, model.pressure_pa, f, x, v, advice, &residual);
-    if (!reason.empty()) break;
+    if (reason) break;
   }
   r.final_pressure_pa = model.pressure_pa;
-  mon.finish(x, v, step, eval.evaluations(), reason == "converged", reason.empty() ? "step limit" : reason, residual);
+  mon.finish(x, v, step, eval.evaluations(), reason.value_or(StopReason::StepLimit), residual);
   return r;
 }
 

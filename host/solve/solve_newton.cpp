@@ -50,8 +50,7 @@ SolveResult solve_newton_on(const Mesh& m, const SolveOptions& opt, ForceField& 
   Shift shift;
   int64_t step = 0, cg_iterations = 0;
   double residual = INFINITY;
-  bool converged = false;
-  std::string reason = "step limit";
+  StopReason reason = StopReason::StepLimit;
   for (int inc = 1; inc <= increments; ++inc) {
     model.pressure_pa = detail::increment_pressure(opt, inc, increments);
     const bool last = inc == increments;
@@ -91,7 +90,7 @@ SolveResult solve_newton_on(const Mesh& m, const SolveOptions& opt, ForceField& 
         trial_inverted = count_inverted(m, trial);
         if ((accepted = trial_inverted <= inverted)) break;
       }
-      if (!accepted) { reason = "no descent"; break; }
+      if (!accepted) { reason = StopReason::NoDescent; break; }
       if (alpha == 1.0) shift.relax();
       x.swap(trial);
       f.swap(f_trial);
@@ -101,16 +100,16 @@ SolveResult solve_newton_on(const Mesh& m, const SolveOptions& opt, ForceField& 
       ++step;
       mon.check_diverged(x, step, advice);
       residual = mon.residual(f);
-      if (mon.record(step, 0.0, model.pressure_pa, residual, x, {})) { reason = "inverted tetrahedra"; break; }
+      if (mon.record(step, 0.0, model.pressure_pa, residual, x, {})) { reason = StopReason::InvertedTetrahedra; break; }
       increment_done = residual < tol;
     }
-    if (reason == "inverted tetrahedra" || reason == "no descent") break;
-    if (last && increment_done) { converged = true; reason = "converged"; }
+    if (reason == StopReason::InvertedTetrahedra || reason == StopReason::NoDescent) break;
+    if (last && increment_done) reason = StopReason::Converged;
     if (!increment_done) break;
   }
   r.final_pressure_pa = model.pressure_pa;
   r.inner_iterations = cg_iterations;
-  mon.finish(x, {}, step, field.evaluations(), converged, reason, residual);
+  mon.finish(x, {}, step, field.evaluations(), reason, residual);
   return r;
 }
 

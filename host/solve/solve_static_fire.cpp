@@ -31,8 +31,7 @@ SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vecto
   std::vector<Vec3> v(N, Vec3::Zero()), f;
   int64_t step = 0;
   double residual = INFINITY;
-  bool converged = false;
-  std::string reason = "step limit";
+  StopReason reason = StopReason::StepLimit;
   const std::string advice = detail::kLoadAdvice;
   for (int inc = 1; inc <= increments && step < opt.max_steps; ++inc) {
     model.pressure_pa = detail::increment_pressure(opt, inc, increments);
@@ -67,16 +66,16 @@ SolveResult solve_static_fire(const Mesh& m, const SolveOptions& opt, std::vecto
       if (step % opt.monitor_every == 0 || step == opt.max_steps) {
         mon.check_diverged(x, step, advice);
         residual = mon.residual(f);
-        if (mon.record(step, 0.0, model.pressure_pa, residual, x, {})) { reason = "inverted tetrahedra"; break; }
+        if (mon.record(step, 0.0, model.pressure_pa, residual, x, {})) { reason = StopReason::InvertedTetrahedra; break; }
         if (residual < tol) { increment_done = true; break; }
       }
     }
-    if (reason == "inverted tetrahedra") break;
-    if (last && increment_done) { converged = true; reason = "converged"; }
+    if (reason == StopReason::InvertedTetrahedra) break;
+    if (last && increment_done) reason = StopReason::Converged;
     if (!increment_done) break;
   }
   r.final_pressure_pa = model.pressure_pa;
-  mon.finish(x, {}, step, field->evaluations(), converged, reason, residual);
+  mon.finish(x, {}, step, field->evaluations(), reason, residual);
   return r;
 }
 

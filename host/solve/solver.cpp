@@ -1,6 +1,7 @@
 #include "solve/solver.h"
 
 #include <cmath>
+#include <ostream>
 
 #include "core/error.h"
 #include "core/units.h"
@@ -33,6 +34,18 @@ double stable_time_step(const Mesh& m, bool damping) {
   }
   return dt;
 }
+
+const char* stop_reason_text(StopReason r) {
+  switch (r) {
+    case StopReason::Converged: return "converged";
+    case StopReason::StepLimit: return "step limit";
+    case StopReason::InvertedTetrahedra: return "inverted tetrahedra";
+    case StopReason::NoDescent: return "no descent";
+  }
+  return "unknown";
+}
+
+std::ostream& operator<<(std::ostream& os, StopReason r) { return os << stop_reason_text(r); }
 
 double ramp_factor(double t_s, double ramp_s, RampShape shape) {
   if (!(ramp_s > 0.0) || t_s >= ramp_s) return 1.0;

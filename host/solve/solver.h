@@ -4,6 +4,7 @@
 // solver (FIRE). The plain C++ reference; SI units inside (m, s, N, Pa).
 #include <cstdint>
 #include <functional>
+#include <iosfwd>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -60,11 +61,22 @@ struct SolveSample {              // one row of the convergence history
   double time_s = 0, pressure_pa = 0, residual = 0, max_displacement_m = 0, max_speed_m_s = 0;
 };
 
+/// Why a solve stopped. stop_reason_text() is the one place each is spelled (progress lines,
+/// metrics.json, messages); code compares the values, never the text.
+enum class StopReason : uint8_t {
+  Converged,           // residual (and, dynamic, speed) below tolerance at the full load
+  StepLimit,           // solver.max_steps reached first
+  InvertedTetrahedra,  // solver.on_inverted = "stop" and a tetrahedron turned inside out
+  NoDescent,           // Newton: the line search found no step that lowers the energy
+};
+const char* stop_reason_text(StopReason r);
+std::ostream& operator<<(std::ostream& os, StopReason r);   // the text, for test messages
+
 struct SolveResult {
   std::vector<Vec3> x;            // final positions (m)
   std::vector<Vec3> v;            // final velocities (m/s; zero for the static schemes)
   bool converged = false;
-  std::string stop_reason;        // "converged", "step limit", "inverted tetrahedra"
+  StopReason stop_reason = StopReason::StepLimit;   // converged == (stop_reason == Converged)
   std::string solver;
   int64_t steps = 0, force_evaluations = 0, inner_iterations = 0;
   double wall_time_s = 0, residual = 0, dt_s = 0, dt_stable_s = 0, final_pressure_pa = 0;

@@ -115,7 +115,7 @@ SolveResult explicit_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& op
   const std::string advice = detail::dt_advice(dt, r.dt_stable_s);
   int64_t step = 0;
   double residual = INFINITY;
-  std::string reason;
+  std::optional<StopReason> reason;   // none: go on
   while (step < opt.max_steps) {
     const double t = step * dt;
     model.pressure_pa = detail::ramped_pressure(opt, t);
@@ -127,11 +127,11 @@ SolveResult explicit_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& op
     reason = mon.check_dynamic(step, t + dt, model.pressure_pa, o.max_free_force / mon.reference_load(),
                                o.max_displacement, o.max_speed, advice,
                                lazy_positions(d, d.eval.positions(), cache), &residual);
-    if (!reason.empty()) break;
+    if (reason) break;
   }
   r.final_pressure_pa = model.pressure_pa;
-  mon.finish(d.eval.download_positions(d.eval.positions()), d.download(d.eval.velocities()), step, step, reason == "converged",
-             reason.empty() ? "step limit" : reason, residual);
+  mon.finish(d.eval.download_positions(d.eval.positions()), d.download(d.eval.velocities()), step, step,
+             reason.value_or(StopReason::StepLimit), residual);
   return r;
 }
 
@@ -162,7 +162,7 @@ SolveResult newmark_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt
   const std::string advice = detail::dt_advice(dt, r.dt_stable_s);
   int64_t step = 0, evaluations = 0;
   double residual = INFINITY;
-  std::string reason;
+  std::optional<StopReason> reason;   // none: go on
   while (step < opt.max_steps) {
     const double t_next = (step + 1) * dt;
     model.pressure_pa = detail::ramped_pressure(opt, t_next);
@@ -187,11 +187,11 @@ SolveResult newmark_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& opt
     reason = mon.check_dynamic(step, t_next, model.pressure_pa, o.max_free_force / mon.reference_load(),
                                o.max_displacement, o.max_speed, advice,
                                lazy_positions(d, x, cache), &residual);
-    if (!reason.empty()) break;
+    if (reason) break;
   }
   r.final_pressure_pa = model.pressure_pa;
-  mon.finish(d.eval.download_positions(x), d.download(v), step, evaluations, reason == "converged",
-             reason.empty() ? "step limit" : reason, residual);
+  mon.finish(d.eval.download_positions(x), d.download(v), step, evaluations,
+             reason.value_or(StopReason::StepLimit), residual);
   return r;
 }
 
@@ -207,7 +207,7 @@ SolveResult kitasaka_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& op
   std::vector<Vec3> cache;
   int64_t step = 0, evaluations = 0;
   double residual = INFINITY;
-  std::string reason;
+  std::optional<StopReason> reason;   // none: go on
   bool forces_are_current = false;   // the monitor just evaluated them at these positions
   while (step < opt.max_steps) {
     if (!forces_are_current) {
@@ -227,14 +227,14 @@ SolveResult kitasaka_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions& op
     residual = o.max_free_force / mon.reference_load();
     if (mon.record(step, 0.0, model.pressure_pa, residual, o.max_displacement, 0.0,
                    lazy_positions(d, d.eval.positions(), cache))) {
-      reason = "inverted tetrahedra";
+      reason = StopReason::InvertedTetrahedra;
       break;
     }
-    if (done) { reason = "converged"; break; }
+    if (done) { reason = StopReason::Converged; break; }
   }
   r.final_pressure_pa = model.pressure_pa;
-  mon.finish(d.eval.download_positions(d.eval.positions()), {}, step, evaluations, reason == "converged",
-             reason.empty() ? "step limit" : reason, residual);
+  mon.finish(d.eval.download_positions(d.eval.positions()), {}, step, evaluations,
+             reason.value_or(StopReason::StepLimit), residual);
   return r;
 }
 
@@ -255,7 +255,7 @@ SolveResult static_fire_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions&
   std::vector<Vec3> cache;
   int64_t step = 0, evaluations = 0;
   double residual = INFINITY;
-  std::string reason;
+  std::optional<StopReason> reason;   // none: go on
   auto evaluate = [&] {
     d.eval.evaluate(model, ClForceEvaluator::Nodes::Free);
     d.run(mask);
@@ -292,17 +292,17 @@ SolveResult static_fire_cl(ocl::Context& ctx, const Mesh& m, const SolveOptions&
       mon.check_diverged(o.max_displacement, step, detail::kLoadAdvice);
       residual = o.max_free_force / mon.reference_load();
       if (mon.record(step, 0.0, model.pressure_pa, residual, o.max_displacement, 0.0, lazy_positions(d, x, cache))) {
-        reason = "inverted tetrahedra";
+        reason = StopReason::InvertedTetrahedra;
         break;
       }
       if (residual < tol) { increment_done = true; break; }
     }
-    if (!reason.empty()) break;
-    if (last && increment_done) reason = "converged";
+    if (reason) break;
+    if (last && increment_done) reason = StopReason::Converged;
     if (!increment_done) break;
   }
   r.final_pressure_pa = model.pressure_pa;
-  mon.finish(d.eval.download_positions(x), {}, step, evaluations, reason == "converged", reason.empty() ? "step limit" : reason,
+  mon.finish(d.eval.download_positions(x), {}, step, evaluations, reason.value_or(StopReason::StepLimit),
              residual);
   return r;
 }

@@ -190,34 +190,35 @@ bool Monitor::record(int64_t step, double time_s, double pressure_pa, double res
   return false;
 }
 
-std::string Monitor::check_dynamic(int64_t step, double time_s, double pressure_pa, const std::vector<Vec3>& f,
+std::optional<StopReason> Monitor::check_dynamic(int64_t step, double time_s, double pressure_pa, const std::vector<Vec3>& f,
                                    const std::vector<Vec3>& x, const std::vector<Vec3>& v, const std::string& advice,
                                    double* residual) {
-  if (step % opt_.monitor_every != 0 && step != opt_.max_steps) return "";
+  if (step % opt_.monitor_every != 0 && step != opt_.max_steps) return std::nullopt;
   return check_dynamic(step, time_s, pressure_pa, this->residual(f), max_displacement(x), max_speed(v), advice,
                        [&]() -> const std::vector<Vec3>& { return x; }, residual);
 }
 
-std::string Monitor::check_dynamic(int64_t step, double time_s, double pressure_pa, double residual_now,
+std::optional<StopReason> Monitor::check_dynamic(int64_t step, double time_s, double pressure_pa, double residual_now,
                                    double max_displacement_m, double max_speed_m_s, const std::string& advice,
                                    const std::function<const std::vector<Vec3>&()>& positions, double* residual) {
   check_diverged(max_displacement_m, step, advice);
   *residual = residual_now;
   if (record(step, time_s, pressure_pa, residual_now, max_displacement_m, max_speed_m_s, positions))
-    return "inverted tetrahedra";
+    return StopReason::InvertedTetrahedra;
   const bool ramped = time_s >= opt_.ramp_s;
   const bool still = ramped && residual_now < opt_.residual_tolerance && max_speed_m_s < opt_.velocity_tolerance_m_s;
   held_steps_ = still ? held_steps_ + opt_.monitor_every : 0;
-  return held_steps_ >= opt_.hold_steps ? "converged" : "";
+  if (held_steps_ >= opt_.hold_steps) return StopReason::Converged;
+  return std::nullopt;
 }
 
 void Monitor::finish(const std::vector<Vec3>& x, const std::vector<Vec3>& v, int64_t steps, int64_t force_evaluations,
-                     bool converged, const std::string& stop_reason, double residual) {
+                     StopReason stop_reason, double residual) {
   r_.x = x;
   r_.v = v.empty() ? std::vector<Vec3>(x.size(), Vec3::Zero()) : v;
   r_.steps = steps;
   r_.force_evaluations = force_evaluations;
-  r_.converged = converged;
+  r_.converged = stop_reason == StopReason::Converged;
   r_.stop_reason = stop_reason;
   r_.residual = residual;
   r_.inverted_tetrahedra = count_inverted(m_, x);
@@ -228,7 +229,7 @@ void Monitor::finish(const std::vector<Vec3>& x, const std::vector<Vec3>& v, int
               "avoids them");
   r_.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   char detail[160];
-  std::snprintf(detail, sizeof detail, "%s after %lld steps, residual %.2e", stop_reason.c_str(), (long long)steps,
+  std::snprintf(detail, sizeof detail, "%s after %lld steps, residual %.2e", stop_reason_text(stop_reason), (long long)steps,
                 residual);
   if (opt_.progress) progress_.finish(detail);
 }

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -136,18 +137,18 @@ class Monitor {
   bool record(int64_t step, double time_s, double pressure_pa, double residual, double max_displacement_m,
               double max_speed_m_s, const std::function<const std::vector<Vec3>&()>& positions);
   /// Every monitor_every steps of a dynamic scheme: checks divergence, records, and counts how long
-  /// residual and speed have stayed below their tolerances after the ramp. Returns "" to go on, or
-  /// the stop reason ("converged", "inverted tetrahedra"); `residual` is updated when checked.
-  std::string check_dynamic(int64_t step, double time_s, double pressure_pa, const std::vector<Vec3>& f,
+  /// residual and speed have stayed below their tolerances after the ramp. Returns none to go on,
+  /// else why to stop (Converged, InvertedTetrahedra); `residual` is updated when checked.
+  std::optional<StopReason> check_dynamic(int64_t step, double time_s, double pressure_pa, const std::vector<Vec3>& f,
                             const std::vector<Vec3>& x, const std::vector<Vec3>& v, const std::string& advice,
                             double* residual);
   /// The same from scalars (the residual already divided by reference_load()); call it only on
   /// monitoring steps.
-  std::string check_dynamic(int64_t step, double time_s, double pressure_pa, double residual_now,
+  std::optional<StopReason> check_dynamic(int64_t step, double time_s, double pressure_pa, double residual_now,
                             double max_displacement_m, double max_speed_m_s, const std::string& advice,
                             const std::function<const std::vector<Vec3>&()>& positions, double* residual);
   void finish(const std::vector<Vec3>& x, const std::vector<Vec3>& v, int64_t steps, int64_t force_evaluations,
-              bool converged, const std::string& stop_reason, double residual);
+              StopReason stop_reason, double residual);
   double reference_load() const { return ref_load_; }
 
  private:
