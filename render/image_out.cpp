@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "report/png.h"
+#include "image/png.h"
 
 namespace pneumo {
 

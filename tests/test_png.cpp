@@ -1,4 +1,4 @@
-// PNG writers (host/report/png.h): what is written reads back identically (stb_image), 16-bit
+// PNG writers (host/image/png.h): what is written reads back identically (stb_image), 16-bit
 // samples keep their byte order, and a failed write leaves neither a partial file nor a temporary.
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "io_test_support.h"
-#include "report/png.h"
+#include "image/png.h"
 
 #include "stb_image_support.h"
 

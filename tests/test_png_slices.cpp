@@ -6,7 +6,7 @@
 #include <functional>
 
 #include "io_test_support.h"
-#include "report/png.h"
+#include "image/png.h"
 #include "report/slices.h"
 
 using namespace pneumo;

@@ -4,7 +4,7 @@
 #include <fstream>
 
 #include "io_test_support.h"
-#include "report/png.h"
+#include "image/png.h"
 #include "report/report_html.h"
 
 using namespace pneumo;

@@ -20,7 +20,7 @@
 #include "pipeline/timelapse.h"
 #include "pipeline/warp_stage.h"
 #include "report/report_html.h"
-#include "roles/role_png.h"
+#include "report/role_png.h"
 
 namespace pneumo {
 

@@ -12,7 +12,7 @@
 #include "core/log.h"
 #include "core/units.h"
 #include "io/volume_io.h"
-#include "report/png.h"
+#include "image/png.h"
 #include "report/slices.h"
 #include "roles/connected_components.h"
 #include "warp/cavity_specks.h"

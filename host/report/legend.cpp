@@ -2,7 +2,7 @@
 #include <algorithm>
 
 #include "report/slices.h"
-#include "report/text.h"
+#include "image/text.h"
 
 namespace pneumo {
 

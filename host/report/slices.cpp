@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "report/text.h"
+#include "image/text.h"
 
 namespace pneumo {
 

@@ -18,7 +18,7 @@
 
 #include "core/geometry.h"
 #include "io/volume.h"
-#include "report/image.h"
+#include "image/image.h"
 
 namespace pneumo {
 

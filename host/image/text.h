@@ -3,7 +3,7 @@
 // a tiny ASCII bitmap font, about 6 px per character and 7 px tall at scale 1.
 #include <string>
 
-#include "report/image.h"
+#include "image/image.h"
 
 namespace pneumo {
 

@@ -1,8 +1,8 @@
-#include "roles/role_png.h"
+#include "report/role_png.h"
 
 #include <cstdio>
 
-#include "report/png.h"
+#include "image/png.h"
 #include "report/slices.h"
 
 namespace pneumo {

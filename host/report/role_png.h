@@ -7,7 +7,7 @@
 #include <string>
 
 #include "core/geometry.h"
-#include "report/image.h"
+#include "image/image.h"
 #include "roles/roles.h"
 
 namespace pneumo {

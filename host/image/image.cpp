@@ -1,4 +1,4 @@
-#include "report/image.h"
+#include "image/image.h"
 
 #include <algorithm>
 #include <cstring>

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "report/image.h"
+#include "image/image.h"
 
 namespace pneumo {
 

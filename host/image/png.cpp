@@ -1,6 +1,6 @@
 // stb_image_write encodes the 8-bit images; it has no 16-bit PNG, so the grey16 writer builds its
 // few chunks itself with zlib (which pneumo links anyway for .nii.gz).
-#include "report/png.h"
+#include "image/png.h"
 
 #include <zlib.h>
 

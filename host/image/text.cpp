@@ -1,4 +1,4 @@
-#include "report/text.h"
+#include "image/text.h"
 
 #include <algorithm>
 #include <cmath>
