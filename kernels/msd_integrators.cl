@@ -5,7 +5,22 @@
 // branch. Reductions write one float4 per work-group (a fixed tree, so the same bits every run);
 // the host combines the groups in a fixed order.
 
-#define LOCAL_SIZE 64
+// PNEUMO_WORK_GROUP: the launch's work-group size, defined by the host (ocl::kWorkGroupSize).
+#ifndef PNEUMO_WORK_GROUP
+#error "PNEUMO_WORK_GROUP is defined by the host's build options (host/cl/cl_runtime.h)"
+#endif
+
+// The work-group's reduction, one fixed tree (the same bits every run): s[0] ends holding the
+// element-wise max (max_not_sum) or sum of s[0 .. PNEUMO_WORK_GROUP). Every work-item calls it after
+// writing its own s[l].
+float4 reduce_group(__local float4* s, const int l, const int max_not_sum) {
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (int w = PNEUMO_WORK_GROUP / 2; w > 0; w >>= 1) {
+    if (l < w) s[l] = max_not_sum ? fmax(s[l], s[l + w]) : s[l] + s[l + w];
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  return s[0];
+}
 
 // v ← (v + Δt·F/m)·hold; x ← x + Δt·v (symplectic Euler).
 __kernel void explicit_step(__global float4* restrict x, __global float4* restrict v, __global const float4* restrict f,
@@ -22,7 +37,7 @@ __kernel void explicit_step(__global float4* restrict x, __global float4* restri
 __kernel void monitor(__global const float4* restrict f, __global const float4* restrict v,
                       __global const float4* restrict x, __global const float4* restrict hold, const int n,
                       __global float4* restrict partial) {
-  __local float4 s[LOCAL_SIZE];
+  __local float4 s[PNEUMO_WORK_GROUP];
   const int i = get_global_id(0), l = get_local_id(0);
   float4 m = (float4)(0.0f);
   if (i < n) {
@@ -32,12 +47,8 @@ __kernel void monitor(__global const float4* restrict f, __global const float4* 
     m = (float4)(fmax(fh.x, fmax(fh.y, fh.z)), length(v[i].xyz), finite ? length(d) : INFINITY, 0.0f);
   }
   s[l] = m;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (int w = LOCAL_SIZE / 2; w > 0; w >>= 1) {
-    if (l < w) s[l] = fmax(s[l], s[l + w]);
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
-  if (l == 0) partial[get_group_id(0)] = s[0];
+  const float4 group = reduce_group(s, l, 1);
+  if (l == 0) partial[get_group_id(0)] = group;
 }
 
 // F ← F·hold (the static schemes work with the free components only).
@@ -49,15 +60,11 @@ __kernel void mask_forces(__global float4* restrict f, __global const float4* re
 // Per group: (Σ F·v, Σ |v|², Σ |F|², 0), for FIRE.
 __kernel void fire_sums(__global const float4* restrict f, __global const float4* restrict v, const int n,
                         __global float4* restrict partial) {
-  __local float4 s[LOCAL_SIZE];
+  __local float4 s[PNEUMO_WORK_GROUP];
   const int i = get_global_id(0), l = get_local_id(0);
   s[l] = i < n ? (float4)(dot(f[i], v[i]), dot(v[i], v[i]), dot(f[i], f[i]), 0.0f) : (float4)(0.0f);
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (int w = LOCAL_SIZE / 2; w > 0; w >>= 1) {
-    if (l < w) s[l] += s[l + w];
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
-  if (l == 0) partial[get_group_id(0)] = s[0];
+  const float4 group = reduce_group(s, l, 0);
+  if (l == 0) partial[get_group_id(0)] = group;
 }
 
 // FIRE's restart after uphill motion: x ← x − ½Δt·v, v ← 0.
@@ -112,7 +119,7 @@ __kernel void newmark_trial(__global const float4* restrict xp, __global const f
 __kernel void newmark_accel(__global const float4* restrict f, __global const float* restrict inv_mass,
                             __global const float4* restrict hold, __global float4* restrict a, const int n,
                             __global float4* restrict partial) {
-  __local float4 s[LOCAL_SIZE];
+  __local float4 s[PNEUMO_WORK_GROUP];
   const int i = get_global_id(0), l = get_local_id(0);
   float4 m = (float4)(0.0f);
   if (i < n) {
@@ -122,19 +129,15 @@ __kernel void newmark_accel(__global const float4* restrict f, __global const fl
     a[i] = an;
   }
   s[l] = m;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (int w = LOCAL_SIZE / 2; w > 0; w >>= 1) {
-    if (l < w) s[l] = fmax(s[l], s[l + w]);
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
-  if (l == 0) partial[get_group_id(0)] = s[0];
+  const float4 group = reduce_group(s, l, 1);
+  if (l == 0) partial[get_group_id(0)] = group;
 }
 
 // The 2004 scheme, all nodes at once (Jacobi): ΔR = Δs·F/D·hold, R ← R + ΔR; per group Σ|ΔR|.
 __kernel void kitasaka_step(__global float4* restrict x, __global const float4* restrict f,
                             __global const float* restrict inv_stiffness, __global const float4* restrict hold,
                             const float step, const int n, __global float4* restrict partial) {
-  __local float4 s[LOCAL_SIZE];
+  __local float4 s[PNEUMO_WORK_GROUP];
   const int i = get_global_id(0), l = get_local_id(0);
   float moved = 0.0f;
   if (i < n) {
@@ -143,10 +146,6 @@ __kernel void kitasaka_step(__global float4* restrict x, __global const float4* 
     moved = length(d.xyz);
   }
   s[l] = (float4)(moved, 0.0f, 0.0f, 0.0f);
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (int w = LOCAL_SIZE / 2; w > 0; w >>= 1) {
-    if (l < w) s[l] += s[l + w];
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
-  if (l == 0) partial[get_group_id(0)] = s[0];
+  const float4 group = reduce_group(s, l, 0);
+  if (l == 0) partial[get_group_id(0)] = group;
 }

@@ -155,11 +155,14 @@ std::shared_ptr<Context> Context::shared(const DeviceSpec& spec) {
   return ctx;
 }
 
-const char* Context::default_build_options() { return "-cl-std=CL1.2"; }
+const std::string& Context::default_build_options() {
+  static const std::string options = "-cl-std=CL1.2 -DPNEUMO_WORK_GROUP=" + std::to_string(kWorkGroupSize);
+  return options;
+}
 
 cl::Program& Context::program_from_source(const std::string& name, const std::string& source,
                                           const std::string& options) {
-  const std::string opts = std::string(default_build_options()) + (options.empty() ? "" : " " + options);
+  const std::string opts = default_build_options() + (options.empty() ? "" : " " + options);
   const std::string key = name + "\n" + opts + "\n" + source;
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = programs_.find(key);

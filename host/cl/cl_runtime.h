@@ -9,10 +9,15 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <cstddef>
 #include <string>
 #include <vector>
 
 namespace pneumo::ocl {
+
+/// The work-group size every pneumo kernel is launched with, fixed (PoCL compiles a kernel once per
+/// size). The one place it is written: kernels see it as PNEUMO_WORK_GROUP (default_build_options).
+constexpr std::size_t kWorkGroupSize = 64;
 
 struct DeviceInfo {
   int platform_index = -1, device_index = -1;
@@ -64,9 +69,9 @@ class Context {
   /// `largest_buffer_bytes`) would not fit; call before allocating a case.
   void check_fits(uint64_t bytes, uint64_t largest_buffer_bytes, const std::string& what) const;
 
-  /// Build options every program gets: OpenCL C 1.2, no fast-math, so results stay comparable with
-  /// the CPU reference.
-  static const char* default_build_options();
+  /// Build options every program gets: OpenCL C 1.2, PNEUMO_WORK_GROUP defined as kWorkGroupSize,
+  /// no fast-math, so results stay comparable with the CPU reference.
+  static const std::string& default_build_options();
 
  private:
   Context(const cl::Device& d, const DeviceInfo& info);

@@ -12,7 +12,7 @@ namespace pneumo {
 
 namespace {
 
-constexpr std::size_t kLocal = 64;   // the work-group size every pneumo kernel runs with
+constexpr std::size_t kLocal = ocl::kWorkGroupSize;
 // The element state's layout shared with fem_forces.cl (passed as build options): floats per
 // tetrahedron, and where its dilatation e and deviatoric energy density ψ sit.
 constexpr int kStateFloats = 40;

@@ -8,7 +8,7 @@ namespace pneumo {
 
 namespace {
 
-constexpr std::size_t kLocal = 64;   // fixed work-group size: PoCL compiles once per (kernel, size)
+constexpr std::size_t kLocal = ocl::kWorkGroupSize;
 constexpr int kBlock = 8;            // nodes per work-item in node_forces (W in msd_forces.cl)
 
 std::size_t global_size(int64_t n) { return (std::size_t(n) + kLocal - 1) / kLocal * kLocal; }

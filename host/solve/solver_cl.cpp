@@ -12,7 +12,7 @@ namespace pneumo {
 
 namespace {
 
-constexpr std::size_t kLocal = 64;   // LOCAL_SIZE of kernels/msd_integrators.cl
+constexpr std::size_t kLocal = ocl::kWorkGroupSize;
 
 using ocl::set_args;
 

@@ -12,7 +12,7 @@ namespace pneumo {
 
 namespace {
 
-constexpr std::size_t kLocal = 64;   // both kernels' work-group (fixed: PoCL compiles per size)
+constexpr std::size_t kLocal = ocl::kWorkGroupSize;
 
 cl_int4 int4_of(const Index3& v) { return {{cl_int(v[0]), cl_int(v[1]), cl_int(v[2]), 0}}; }
 
