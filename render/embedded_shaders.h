@@ -3,12 +3,11 @@
 #include <string>
 #include <vector>
 
+#include "core/embedded_files.h"
+
 namespace pneumo::gl {
 
-struct EmbeddedShader {
-  const char* path;  // relative to shaders/, e.g. "raycast.frag"
-  std::string source;
-};
+using EmbeddedShader = EmbeddedFile;   // path relative to shaders/, e.g. "raycast.frag"
 
 const std::vector<EmbeddedShader>& embedded_shaders();
 

@@ -3,12 +3,11 @@
 #include <string>
 #include <vector>
 
+#include "core/embedded_files.h"
+
 namespace pneumo::ocl {
 
-struct EmbeddedKernel {
-  const char* path;    // relative to kernels/, e.g. "stream_triad.cl" or "common/math.cl"
-  std::string source;
-};
+using EmbeddedKernel = EmbeddedFile;   // path relative to kernels/, e.g. "common/math.cl"
 
 const std::vector<EmbeddedKernel>& embedded_kernels();
 
