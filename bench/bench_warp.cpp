@@ -1,5 +1,5 @@
 // Image-warp throughput (method.md §7): output voxels per second for the large phantom (512×512×400 at
-// 0.75 mm, 105 M voxels), CPU reference (double, 1 thread and all threads) against every OpenCL device
+// 0.75 mm, 105 M voxels), the CPU warp (double, 1 thread and all threads) against every OpenCL device
 // (float32), each next to the STREAM-triad bandwidth measured in this process.
 //
 //   POCL_CACHE_DIR=/tmp/pocl build/bench/pneumo_bench --benchmark_filter=Warp
@@ -10,7 +10,7 @@
 // exactly what `pneumo warp` gets. Setting it up takes about a minute (phantom, solve) and is not timed.
 //
 // Names: BM_Warp/<device>/large, device = cpu_1thread, cpu_<N>threads, opencl_<platform>_<device>.
-// One iteration is one whole warp as the pipeline calls it: warp_ref, or warp_opencl including the
+// One iteration is one whole warp as the pipeline calls it: warp_cpu, or warp_opencl including the
 // tetrahedra's preparation, uploads of the source volumes and downloads of the results (on PoCL those
 // are memory copies the pipeline pays too). Kernels are built before timing.
 //
@@ -125,7 +125,7 @@ void BM_WarpCpu(benchmark::State& state, int threads) {
   const auto t0 = Clock::now();
   int64_t gas = 0;
   for (auto _ : state) {   // one warp a repetition, on fresh memory, as `pneumo warp` runs
-    const WarpResult r = warp_ref(c.mesh, c.source(), c.box, options());
+    const WarpResult r = warp_on_device(nullptr, c.mesh, c.source(), c.box, options());
     gas = r.gas_voxels;
     benchmark::DoNotOptimize(r.ct_hu.data());
   }
@@ -133,19 +133,19 @@ void BM_WarpCpu(benchmark::State& state, int threads) {
   omp_set_num_threads(before);
   state.counters["gas_voxels"] = double(gas);
   report(state, seconds, c.box.voxel_count(), kCpuBytesPerVoxel, bw, c0,
-         "CPU reference, double, " + std::to_string(threads) + " thread(s)");
+         "CPU warp, double, " + std::to_string(threads) + " thread(s)");
 }
 
 void BM_WarpCl(benchmark::State& state, ocl::DeviceInfo info) {
   const WarpCase& c = warp_case();
   auto ctx = ocl::Context::shared(ocl::parse_device_spec(info.spec()));
   const double bw = perf::measure_triad_opencl(*ctx, kTriadBytes, kTriadReps).median_gb_s;
-  warp_opencl(*ctx, c.mesh, c.source(), c.box, options());   // builds the program, compiles both kernels
+  warp_on_device(ctx.get(), c.mesh, c.source(), c.box, options());   // builds the program, compiles both kernels
   const CpuSample c0 = cpu_sample();
   const auto t0 = Clock::now();
   int64_t gas = 0;
   for (auto _ : state) {
-    const WarpResult r = warp_opencl(*ctx, c.mesh, c.source(), c.box, options());
+    const WarpResult r = warp_on_device(ctx.get(), c.mesh, c.source(), c.box, options());
     gas = r.gas_voxels;
     benchmark::DoNotOptimize(r.ct_hu.data());
   }

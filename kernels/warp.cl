@@ -1,5 +1,5 @@
 // The barycentric image warp (method.md §7) on the device, float32. host/warp/warp.h states the
-// rules; host/warp/warp_ref.cpp is the double-precision reference this must equal (CT within a
+// rules; host/warp/warp_cpu.cpp is the double-precision CPU warp this must equal (CT within a
 // stated tolerance, labels exactly except at measured ties).
 //
 // Two passes, no order dependence:

@@ -97,7 +97,7 @@ TEST(PeerWarp, NoLiftGivesTheInputBitForBit) {
   const Geometry g = peer_grid({25, 17, 17}, {0.7, 0.7, 1.0}, {0, 0, 0});
   const std::vector<float> ct = random_ct(g, 3);
   const PeerWarpCase c = make_peer_warp_case(g, ct, 8, lift_at({8, 5, 8}, 2.0, 0.0));
-  const WarpResult r = warp_ref(c.mesh, c.source(), c.box, WarpOptions{});
+  const WarpResult r = warp_cpu(c.mesh, c.source(), c.box, WarpOptions{});
   EXPECT_EQ(r.carried_voxels, g.voxel_count());
   EXPECT_EQ(r.ct_hu, ct);
 }
@@ -123,7 +123,7 @@ TEST(PeerWarp, WritesTheVolumesTheComparisonReads) {
   // What was written is what the warp computes on the same case.
   const PeerWarpCase c = make_peer_warp_case(read_volume(dir.file("phantom.mhd")).geometry(), ct, 8,
                                              lift_at({11.2, 11.2, 8.0}, 12.0, 6.0));
-  const WarpResult r = warp_ref(c.mesh, c.source(), c.box, WarpOptions{});
+  const WarpResult r = warp_cpu(c.mesh, c.source(), c.box, WarpOptions{});
   const Volume warped = read_volume(dir.file("pneumo/warped_cpu.mhd"));
   ASSERT_EQ(warped.type(), VoxelType::Float32);
   EXPECT_EQ(std::vector<float>(warped.data<float>(), warped.data<float>() + warped.voxel_count()), r.ct_hu);

@@ -234,8 +234,8 @@ json measure_case_throughput(BenchContext& ctx, const BenchCase& c, int pipeline
         for (std::size_t n = 0; n < u.size(); ++n) u[n] = r.x[n] - c.mesh.rest_m[n];
         t0 = Clock::now();
         const WarpMesh wm = make_warp_mesh(c.mesh, u);
-        if (d.opencl()) w = warp_opencl(ctx.cl(d), wm, c.warp_source(), c.warp_box(), WarpOptions{});
-        else with_threads(d.threads, [&] { w = warp_ref(wm, c.warp_source(), c.warp_box(), WarpOptions{}); });
+        if (d.opencl()) w = warp_on_device(&ctx.cl(d), wm, c.warp_source(), c.warp_box(), WarpOptions{});
+        else with_threads(d.threads, [&] { w = warp_on_device(nullptr, wm, c.warp_source(), c.warp_box(), WarpOptions{}); });
         warp_s.push_back(seconds_since(t0));
         double frame = 0;
         if (gl) {

@@ -1,7 +1,10 @@
 #pragma once
 // The barycentric image warp (method.md §7; Kitasaka §2.5, Nimura §2.4): the deformed CT and label
-// map from the rest and deformed meshes. Two implementations behind one interface: warp_ref (plain
-// C++, double precision, OpenMP over tiles, the oracle) and warp_opencl (kernels/warp.cl, float).
+// map from the rest and deformed meshes. One entry, warp_on_device (warp_on_device.cpp), over three
+// implementations of the rules below: warp_reference (warp_reference.cpp: the plain voxel loop, one
+// thread, double precision; the tests' oracle), warp_cpu (warp_cpu.cpp: the fast CPU back end,
+// double precision, OpenMP over tiles, row spans in SSE2) and warp_opencl (warp_cl.cpp,
+// kernels/warp.cl, float32). Tests hold warp_cpu to the reference and the kernel to warp_cpu.
 //
 // For each output voxel centre P′ (index coordinates of the working grid, warp_mesh.h):
 //  1. Scatter: each deformed tetrahedron visits the voxel centres of its bounding box; P′ is inside
@@ -62,11 +65,16 @@ struct WarpResult {
   std::string device;                // "cpu" or "opencl:P:D <name>"
 };
 
-/// The CPU reference. Deterministic for any thread count. Shows Progress("warp").
-WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt);
+/// The plain reference: warp.h's rules as a loop over tetrahedra and their boxes' voxels. Slow;
+/// the tests' oracle (result device "cpu-reference").
+WarpResult warp_reference(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt);
+
+/// The fast CPU back end: the reference's result (equal but for ties decided by rounding, within
+/// 1e-15 relative), deterministic for any thread count. Shows Progress("warp").
+WarpResult warp_cpu(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt);
 /// The same into `out`, reusing its outputs' memory where they already have the box's size, and
 /// `scratch` for the prepared tetrahedra (256 bytes each): what a series of warps keeps (WarpSeries).
-void warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt,
+void warp_cpu(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt,
               WarpResult& out, ReusableBuffer& scratch);
 
 /// kernels/warp.cl on a device, float32. Checks the device's memory first (ctx.check_fits with
@@ -77,7 +85,10 @@ WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource
 /// The device memory warp_opencl needs (bytes): what it allocates, every buffer counted.
 uint64_t warp_device_bytes(const WarpMesh& mesh, bool has_labels, const WarpBox& box);
 
-/// warp_ref for "cpu", warp_opencl for "opencl" / "opencl:P:D" (InputError for anything else).
+/// The stage's one entry, as solve_on_device: warp_opencl on `ctx` when given, warp_cpu otherwise.
+WarpResult warp_on_device(ocl::Context* ctx, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,
+                          const WarpOptions& opt);
+/// The same for a device spec: "cpu", "opencl" or "opencl:P:D" (InputError for anything else).
 WarpResult warp_on_device(const std::string& device, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,
                           const WarpOptions& opt);
 

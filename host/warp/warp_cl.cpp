@@ -160,27 +160,4 @@ WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource
   return out;
 }
 
-WarpResult warp_on_device(const std::string& device, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,
-                          const WarpOptions& opt) {
-  const ocl::DeviceSpec spec = ocl::parse_device_spec(device);
-  if (!spec.use_opencl) return warp_ref(mesh, src, box, opt);
-  auto ctx = ocl::Context::shared(spec);
-  log::info("warping on " + ctx->info().spec() + " " + ctx->info().name);
-  return warp_opencl(*ctx, mesh, src, box, opt);
-}
-
-const WarpResult& WarpSeries::warp(const std::string& device, const WarpMesh& mesh, const WarpSource& src,
-                                   const WarpBox& box, const WarpOptions& opt) {
-  try {
-    if (ocl::parse_device_spec(device).use_opencl) {
-      result_ = WarpResult{};   // the last outputs go before the next are allocated
-      result_ = warp_on_device(device, mesh, src, box, opt);
-    } else warp_ref(mesh, src, box, opt, result_, scratch_);
-  } catch (...) {
-    result_ = WarpResult{};   // no half-written result that looks like one
-    throw;
-  }
-  return result_;
-}
-
 }  // namespace pneumo

@@ -1,4 +1,4 @@
-// The CPU reference of the image warp (host/warp/warp_ref.cpp) against closed forms (method.md §10):
+// The fast CPU warp (host/warp/warp_cpu.cpp) against closed forms (method.md §10):
 // identity, whole-voxel translation, affine resampling, no cracks, role acceptance and the gas rule
 // (§7), thread independence; and the point mapping against the same truths and the image warp.
 // Every case runs on a small synthetic grid (warp_test_support.h) with random HU, on grids with
@@ -29,7 +29,7 @@ WarpOptions options() {
   return o;
 }
 
-class WarpRef : public ::testing::Test {
+class WarpCpu : public ::testing::Test {
  protected:
   void SetUp() override { Progress::set_enabled(false); }
 };
@@ -39,10 +39,10 @@ class WarpRef : public ::testing::Test {
 // Identity: zero displacement must return the input bit for bit (CT and labels), carry every
 // voxel of the meshed cubes and make no gas. Tolerance: none (the source point is the voxel centre
 // exactly, and trilinear weights 1 and 0 reproduce it).
-TEST_F(WarpRef, IdentityReturnsTheInputBitForBit) {
+TEST_F(WarpCpu, IdentityReturnsTheInputBitForBit) {
   const WarpCase c = make_warp_case(grid_of({24, 24, 16}, {0.75, 0.75, 1.5}, Vec3(-1, -1, 1).asDiagonal()), 4, 11);
   const WarpMesh m = make_warp_mesh(c.mesh, std::vector<Vec3>(std::size_t(c.mesh.node_count()), Vec3::Zero()));
-  const WarpResult r = warp_ref(m, c.source(), c.whole(), options());
+  const WarpResult r = warp_cpu(m, c.source(), c.whole(), options());
   ASSERT_EQ(r.ct_hu.size(), c.ct.size());
   EXPECT_EQ(std::memcmp(r.ct_hu.data(), c.ct.data(), c.ct.size() * sizeof(float)), 0);
   EXPECT_EQ(r.labels, c.labels);
@@ -60,13 +60,13 @@ TEST_F(WarpRef, IdentityReturnsTheInputBitForBit) {
 // (itself minus the shift) lies in a meshed cube gets that voxel's value and label bit for bit; the
 // meshed space it vacated is gas; everything else keeps its value. Tolerance: none. Spacing in
 // powers of two and a 90° rotated direction keep the displacement exactly whole in index units.
-TEST_F(WarpRef, WholeVoxelTranslationShiftsExactly) {
+TEST_F(WarpCpu, WholeVoxelTranslationShiftsExactly) {
   Mat3 quarter_turn;   // 90° about z, written exactly (AngleAxis leaves 6e-17 for cos 90°)
   quarter_turn << 0, -1, 0, 1, 0, 0, 0, 0, 1;
   const WarpCase c = make_warp_case(grid_of({24, 24, 16}, {0.5, 1.0, 2.0}, quarter_turn), 4, 12);
   const Vec3 shift(2, -1, 1);
   const WarpMesh m = make_warp_mesh(c.mesh, uniform_displacement(c, shift));
-  const WarpResult r = warp_ref(m, c.source(), c.whole(), options());
+  const WarpResult r = warp_cpu(m, c.source(), c.whole(), options());
   const auto parts = cube_parts(c.mesh);
   int64_t carried = 0, gas = 0, bad = 0;
   for (int64_t k = 0; k < 16; ++k)
@@ -96,9 +96,9 @@ TEST_F(WarpRef, WholeVoxelTranslationShiftsExactly) {
 // computed here by the test's own interpolation. Tolerance 1e-3 HU: the reference works in double
 // and rounds once to float (ulp 1.2e-4 at 1500 HU). No cracks: every voxel whose source lies in
 // the meshed space (0.01 voxel clear of its boundary) must be carried, none may be gas.
-TEST_F(WarpRef, AffineMatchesAnalyticResamplingWithNoCracks) {
+TEST_F(WarpCpu, AffineMatchesAnalyticResamplingWithNoCracks) {
   const AffineCase a = affine_case();
-  const WarpResult r = warp_ref(a.mesh, a.c.source(), a.c.whole(), options());
+  const WarpResult r = warp_cpu(a.mesh, a.c.source(), a.c.whole(), options());
   const AffineCheck check = check_affine(a, r, 1e-6);
   EXPECT_GT(check.checked, 3000);
   EXPECT_EQ(check.cracks, 0) << "voxels inside the deformed mesh left uncovered";
@@ -113,14 +113,14 @@ TEST_F(WarpRef, AffineMatchesAnalyticResamplingWithNoCracks) {
 // viscera's only non-wall ones, so the 4-voxel gap that opens is gas (−1000 HU, the cavity label),
 // covered by deformed tetrahedra that accept nothing there or vacated by both. Everything is exact:
 // each voxel's expected value follows from the rule by hand (no two accepting tetrahedra overlap).
-TEST_F(WarpRef, WallAndVisceraSeparateAlongTheInterfaceAndTheGapIsGas) {
+TEST_F(WarpCpu, WallAndVisceraSeparateAlongTheInterfaceAndTheGapIsGas) {
   const WarpCase c = make_warp_case(grid_of({24, 24, 16}, {1.0, 1.0, 1.0}, Mat3::Identity()), 4, 14);
   const Vec3 up(0, 3, 0), down(0, -1, 0);
   std::vector<Vec3> u(std::size_t(c.mesh.node_count()));
   for (int64_t n = 0; n < c.mesh.node_count(); ++n)
     u[std::size_t(n)] = units::mm_to_m(1.0) * (c.mesh.node_part[n] == Part::Wall ? up : down);
   const WarpMesh m = make_warp_mesh(c.mesh, u);
-  const WarpResult r = warp_ref(m, c.source(), c.whole(), options());
+  const WarpResult r = warp_cpu(m, c.source(), c.whole(), options());
   const auto parts = cube_parts(c.mesh);
   const SourceGrid g = c.sampler();
   int64_t bad = 0, gas = 0, wall_carried = 0, viscera_carried = 0;
@@ -162,7 +162,7 @@ TEST_F(WarpRef, WallAndVisceraSeparateAlongTheInterfaceAndTheGapIsGas) {
 
 // The result does not depend on the thread count (a tile's voxels belong to one thread at a time,
 // and the lowest accepting index wins by comparison, not by visiting order). A smooth random deformation with per-node jitter; compared bit for bit.
-TEST_F(WarpRef, SameBitsOnOneAndTwoThreads) {
+TEST_F(WarpCpu, SameBitsOnOneAndTwoThreads) {
   const WarpCase c = make_warp_case(grid_of({24, 20, 16}, {0.8, 0.8, 1.6}, rotation(-15, Vec3(0, 1, 1))), 4, 15);
   std::mt19937 rng(15);
   std::uniform_real_distribution<double> jitter(-0.3, 0.3);
@@ -172,9 +172,9 @@ TEST_F(WarpRef, SameBitsOnOneAndTwoThreads) {
   const WarpMesh m = make_warp_mesh(c.mesh, u);
   const int before = omp_get_max_threads();
   omp_set_num_threads(1);
-  const WarpResult one = warp_ref(m, c.source(), c.whole(), options());
+  const WarpResult one = warp_cpu(m, c.source(), c.whole(), options());
   omp_set_num_threads(2);
-  const WarpResult two = warp_ref(m, c.source(), c.whole(), options());
+  const WarpResult two = warp_cpu(m, c.source(), c.whole(), options());
   omp_set_num_threads(before);
   EXPECT_EQ(std::memcmp(one.ct_hu.data(), two.ct_hu.data(), one.ct_hu.size() * sizeof(float)), 0);
   EXPECT_EQ(one.labels, two.labels);
@@ -185,7 +185,7 @@ TEST_F(WarpRef, SameBitsOnOneAndTwoThreads) {
 // A series of warps reuses its memory (WarpSeries): each warp must give the bits a fresh one gives,
 // whatever the last warp left there. Identity after a lift (stale gas), the lift after identity (stale
 // carried voxels), a smaller box (reallocated), then no labels (their output released).
-TEST_F(WarpRef, ASeriesOfWarpsGivesWhatFreshWarpsGive) {
+TEST_F(WarpCpu, ASeriesOfWarpsGivesWhatFreshWarpsGive) {
   const WarpCase c = make_warp_case(grid_of({24, 20, 16}, {0.8, 0.8, 1.6}, rotation(25, Vec3(1, 0, 1))), 4, 17);
   const WarpMesh lift = make_warp_mesh(c.mesh, displacement_of(c, [&](const Vec3& x) {
     return Vec3(x + Vec3(0.5 * std::sin(x[1] / 4.0), 2.5 * std::cos(x[0] / 6.0), 1.2));
@@ -205,7 +205,7 @@ TEST_F(WarpRef, ASeriesOfWarpsGivesWhatFreshWarpsGive) {
   int n_step = 0;
   for (const Step& s : steps) {
     SCOPED_TRACE("step " + std::to_string(n_step++));
-    const WarpResult fresh = warp_ref(*s.mesh, s.src, s.box, options());
+    const WarpResult fresh = warp_cpu(*s.mesh, s.src, s.box, options());
     const WarpResult& again = series.warp("cpu", *s.mesh, s.src, s.box, options());
     ASSERT_EQ(again.ct_hu.size(), fresh.ct_hu.size());
     EXPECT_EQ(std::memcmp(again.ct_hu.data(), fresh.ct_hu.data(), fresh.ct_hu.size() * sizeof(float)), 0);
@@ -217,7 +217,7 @@ TEST_F(WarpRef, ASeriesOfWarpsGivesWhatFreshWarpsGive) {
     EXPECT_EQ(again.labels.empty(), s.src.labels == nullptr);
   }
   EXPECT_EQ(series.result().labels.capacity(), 0u) << "labels switched off, their memory still held";
-  EXPECT_GT(warp_ref(lift, c.source(), c.whole(), options()).gas_voxels, 0);
+  EXPECT_GT(warp_cpu(lift, c.source(), c.whole(), options()).gas_voxels, 0);
 }
 
 // The reference scatters the tetrahedra of one rest cube together, at most 8 to a group. Declaring
@@ -225,8 +225,8 @@ TEST_F(WarpRef, ASeriesOfWarpsGivesWhatFreshWarpsGive) {
 // indices span the mesh and overlap everywhere: no tetrahedron may be lost and no value change. Same
 // voxels carried, same labels; HU within 1e-3 (the rows start from other corners, so source points
 // differ by rounding, ~1e-13 voxel). Voxels carried by none may differ: the rest space is now the
-// whole grid (gas, not kept). (Groups visited against the index order: WarpClVsRef's reversed trial.)
-TEST_F(WarpRef, GroupingTheTetrahedraLosesNothing) {
+// whole grid (gas, not kept). (Groups visited against the index order: WarpClVsCpu's reversed trial.)
+TEST_F(WarpCpu, GroupingTheTetrahedraLosesNothing) {
   const WarpCase c = make_warp_case(grid_of({24, 20, 16}, {0.8, 0.8, 1.6}, rotation(-15, Vec3(0, 1, 1))), 4, 16);
   auto u = displacement_of(c, [&](const Vec3& x) {
     return Vec3(x + Vec3(1.5 * std::sin(x[1] / 5.0), 1.0 * std::cos(x[0] / 4.0), 0.8 * std::sin(x[2] / 3.0)));
@@ -236,8 +236,8 @@ TEST_F(WarpRef, GroupingTheTetrahedraLosesNothing) {
   one_cube.cube_voxels = 24;
   one_cube.cubes = {1, 1, 1};
   one_cube.cube_meshed = {1};
-  const WarpResult a = warp_ref(by_cube, c.source(), c.whole(), options());
-  const WarpResult b = warp_ref(one_cube, c.source(), c.whole(), options());
+  const WarpResult a = warp_cpu(by_cube, c.source(), c.whole(), options());
+  const WarpResult b = warp_cpu(one_cube, c.source(), c.whole(), options());
   int64_t carried = 0, differ = 0;
   double max_hu = 0;
   for (std::size_t n = 0; n < a.outcome.size(); ++n) {
@@ -255,14 +255,14 @@ TEST_F(WarpRef, GroupingTheTetrahedraLosesNothing) {
 
 // A box inside the working grid (the CT inside the roles' padding): the output is the box's voxels
 // of the whole-grid result, nothing shifted. Compared bit for bit.
-TEST_F(WarpRef, OutputBoxIsTheSameVoxelsAsTheWholeGrid) {
+TEST_F(WarpCpu, OutputBoxIsTheSameVoxelsAsTheWholeGrid) {
   const WarpCase c = make_warp_case(grid_of({24, 24, 16}, {1.0, 1.0, 1.0}, Mat3::Identity()), 4, 16);
   const WarpMesh m = make_warp_mesh(c.mesh, displacement_of(c, [](const Vec3& x) {
     return Vec3(x + Vec3(0.3 * std::sin(x[2]), 0.7, -0.2 * x[0] / 24.0));
   }));
-  const WarpResult whole = warp_ref(m, c.source(), c.whole(), options());
+  const WarpResult whole = warp_cpu(m, c.source(), c.whole(), options());
   const WarpBox box{{3, 2, 1}, {17, 19, 13}};
-  const WarpResult part = warp_ref(m, c.source(), box, options());
+  const WarpResult part = warp_cpu(m, c.source(), box, options());
   int64_t bad = 0;
   for (int64_t k = 0; k < 13; ++k)
     for (int64_t j = 0; j < 19; ++j)
@@ -276,7 +276,7 @@ TEST_F(WarpRef, OutputBoxIsTheSameVoxelsAsTheWholeGrid) {
 // Points through the deformation (point_map.h): an affine deformation maps any point inside the
 // meshes by the affine map and back (1e-9 mm: double rounding over ~30 mm); points outside every
 // tetrahedron are not carried and come back unchanged.
-TEST_F(WarpRef, PointMapFollowsAnAffineDeformationBothWays) {
+TEST_F(WarpCpu, PointMapFollowsAnAffineDeformationBothWays) {
   const WarpCase c = make_warp_case(grid_of({32, 28, 24}, {0.7, 0.9, 1.3}, rotation(20, Vec3(1, 2, 3))), 4, 17);
   const Mat3 M = rotation(4, Vec3(1, 0, 1)) * Vec3(1.03, 1.0, 0.98).asDiagonal();
   const Vec3 b(0.8, 1.7, -0.6);
@@ -307,7 +307,7 @@ TEST_F(WarpRef, PointMapFollowsAnAffineDeformationBothWays) {
 // The point map and the image warp agree: every carried voxel centre, mapped to the original frame,
 // lands where the warp sampled it (its CT value there within 1e-3 HU, float rounding), on a smooth
 // random deformation with separated wall and viscera.
-TEST_F(WarpRef, PointMapAgreesWithTheImageWarp) {
+TEST_F(WarpCpu, PointMapAgreesWithTheImageWarp) {
   const WarpCase c = make_warp_case(grid_of({24, 24, 16}, {0.9, 0.9, 1.8}, rotation(10, Vec3(1, 0, 0))), 4, 18);
   std::vector<Vec3> u(std::size_t(c.mesh.node_count()));
   for (int64_t n = 0; n < c.mesh.node_count(); ++n) {
@@ -316,7 +316,7 @@ TEST_F(WarpRef, PointMapAgreesWithTheImageWarp) {
     u[std::size_t(n)] = 1e-3 * (c.index_to_mm() * lift);
   }
   const WarpMesh m = make_warp_mesh(c.mesh, u);
-  const WarpResult r = warp_ref(m, c.source(), c.whole(), options());
+  const WarpResult r = warp_cpu(m, c.source(), c.whole(), options());
   const PointMap map(m, c.roles.data());
   int64_t checked = 0;
   double worst = 0.0;
@@ -334,7 +334,7 @@ TEST_F(WarpRef, PointMapAgreesWithTheImageWarp) {
 
 // A hand-built mesh whose rest-space table stops short of the grid would be read past its end by both warps (they
 // index it without checks, per voxel): check_warp_mesh refuses it at the door, naming the axis; so do broken ids.
-TEST_F(WarpRef, MeshesThatBreakTheIndexingAreRefusedBeforeWarping) {
+TEST_F(WarpCpu, MeshesThatBreakTheIndexingAreRefusedBeforeWarping) {
   const WarpCase c = make_warp_case(grid_of({24, 24, 16}, {0.75, 0.75, 1.5}, Vec3(-1, -1, 1).asDiagonal()), 4, 11);
   const WarpMesh good = make_warp_mesh(c.mesh, std::vector<Vec3>(std::size_t(c.mesh.node_count()), Vec3::Zero()));
   EXPECT_NO_THROW(check_warp_mesh(good));
@@ -343,7 +343,7 @@ TEST_F(WarpRef, MeshesThatBreakTheIndexingAreRefusedBeforeWarping) {
   short_table.cubes[0] -= 1;
   short_table.cube_meshed.resize(std::size_t(short_table.cubes[0] * short_table.cubes[1] * short_table.cubes[2]));
   try {
-    warp_ref(short_table, c.source(), c.whole(), options());
+    warp_cpu(short_table, c.source(), c.whole(), options());
     ADD_FAILURE() << "a rest-space table one cube short was accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("axis 0"), std::string::npos) << e.what();
@@ -351,5 +351,5 @@ TEST_F(WarpRef, MeshesThatBreakTheIndexingAreRefusedBeforeWarping) {
 
   WarpMesh bad_id = good;
   bad_id.tets[0][2] = int32_t(bad_id.rest_ijk.size());
-  EXPECT_THROW(warp_ref(bad_id, c.source(), c.whole(), options()), std::invalid_argument);
+  EXPECT_THROW(warp_cpu(bad_id, c.source(), c.whole(), options()), std::invalid_argument);
 }

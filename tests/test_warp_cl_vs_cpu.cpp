@@ -1,4 +1,5 @@
-// kernels/warp.cl against the CPU reference (host/warp/warp_ref.cpp), on every OpenCL device found.
+// kernels/warp.cl against the fast CPU warp (host/warp/warp_cpu.cpp, itself held to the plain
+// reference), on every OpenCL device found.
 //  - Identity and whole-voxel translation: bit for bit (both are exact by construction: equal
 //    displacements cancel, whole-number sources sample voxels with weights 1 and 0).
 //  - A smooth random deformation, seeded, at two cube sizes, with wall and viscera separating and
@@ -42,7 +43,7 @@ WarpOptions options() {
   return o;
 }
 
-class WarpClVsRef : public ::testing::TestWithParam<std::string> {
+class WarpClVsCpu : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
     Progress::set_enabled(false);
@@ -53,7 +54,7 @@ class WarpClVsRef : public ::testing::TestWithParam<std::string> {
 
 }  // namespace
 
-TEST_P(WarpClVsRef, IdentityReturnsTheInputBitForBit) {
+TEST_P(WarpClVsCpu, IdentityReturnsTheInputBitForBit) {
   const WarpCase c = make_warp_case(test_grid(), 4, 21);
   const WarpMesh m = make_warp_mesh(c.mesh, std::vector<Vec3>(std::size_t(c.mesh.node_count()), Vec3::Zero()));
   const WarpResult r = warp_opencl(*ctx_, m, c.source(), c.whole(), options());
@@ -63,10 +64,10 @@ TEST_P(WarpClVsRef, IdentityReturnsTheInputBitForBit) {
   EXPECT_GT(r.carried_voxels, 0);
 }
 
-TEST_P(WarpClVsRef, WholeVoxelTranslationEqualsTheReferenceBitForBit) {
+TEST_P(WarpClVsCpu, WholeVoxelTranslationEqualsTheReferenceBitForBit) {
   const WarpCase c = make_warp_case(test_grid(), 4, 22);
   const WarpMesh m = make_warp_mesh(c.mesh, uniform_displacement(c, Vec3(-2, 3, 1)));
-  const WarpResult ref = warp_ref(m, c.source(), c.whole(), options());
+  const WarpResult ref = warp_cpu(m, c.source(), c.whole(), options());
   const WarpResult dev = warp_opencl(*ctx_, m, c.source(), c.whole(), options());
   EXPECT_EQ(std::memcmp(ref.ct_hu.data(), dev.ct_hu.data(), ref.ct_hu.size() * sizeof(float)), 0);
   EXPECT_EQ(ref.labels, dev.labels);
@@ -77,7 +78,7 @@ TEST_P(WarpClVsRef, WholeVoxelTranslationEqualsTheReferenceBitForBit) {
 
 // The affine closed form on the device: CT within the float32 tolerance above, no cracks, labels
 // exact except within 1e-4 of a half (float32 source points).
-TEST_P(WarpClVsRef, AffineMatchesAnalyticResamplingWithNoCracks) {
+TEST_P(WarpClVsCpu, AffineMatchesAnalyticResamplingWithNoCracks) {
   const AffineCase a = affine_case();
   const WarpResult r = warp_opencl(*ctx_, a.mesh, a.c.source(), a.c.whole(), options());
   const AffineCheck check = check_affine(a, r, 1e-4);
@@ -89,7 +90,7 @@ TEST_P(WarpClVsRef, AffineMatchesAnalyticResamplingWithNoCracks) {
               (long long)check.checked, check.worst_hu, (long long)check.label_ties);
 }
 
-TEST_P(WarpClVsRef, RandomDeformationEqualsTheReferenceExceptAtMeasuredTies) {
+TEST_P(WarpClVsCpu, RandomDeformationEqualsTheReferenceExceptAtMeasuredTies) {
   struct Trial {
     uint32_t seed;
     int cube;
@@ -121,7 +122,7 @@ TEST_P(WarpClVsRef, RandomDeformationEqualsTheReferenceExceptAtMeasuredTies) {
       std::reverse(m.tet_part.begin(), m.tet_part.end());
     }
     const WarpBox box{{1, 2, 1}, {22, 21, 18}};   // like a CT inside its padding
-    const WarpResult ref = warp_ref(m, c.source(), box, options());
+    const WarpResult ref = warp_cpu(m, c.source(), box, options());
     const WarpResult dev = warp_opencl(*ctx_, m, c.source(), box, options());
     // The sample pass's layouts (a CPU's long chunks, a GPU's one voxel per work-item) give the same bits.
     for (int chunk : {1, 7, 32}) {
@@ -160,6 +161,6 @@ TEST_P(WarpClVsRef, RandomDeformationEqualsTheReferenceExceptAtMeasuredTies) {
   }
 }
 
-GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(WarpClVsRef);
-INSTANTIATE_TEST_SUITE_P(OpenCL, WarpClVsRef, ::testing::ValuesIn(testing_support::opencl_device_specs()),
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(WarpClVsCpu);
+INSTANTIATE_TEST_SUITE_P(OpenCL, WarpClVsCpu, ::testing::ValuesIn(testing_support::opencl_device_specs()),
                          [](const auto& info) { return testing_support::spec_name(info.param); });

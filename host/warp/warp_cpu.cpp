@@ -1,5 +1,6 @@
-// The CPU reference of the image warp (warp.h states the rules; method.md §7). Double precision,
-// written apart from the kernel (kernels/warp.cl) so the equality test is not blind to shared bugs.
+// The fast CPU back end of the image warp (warp.h states the rules; method.md §7). Double precision,
+// written apart from the kernel (kernels/warp.cl) so their equality test is not blind to shared
+// bugs, and held to the plain reference (warp_reference.cpp) by tests/test_warp_reference.cpp.
 //
 // Scatter without atomics: the output is cut into tiles small enough that a tile's output and the
 // source it reads stay in a core's L2 cache (a voxel's trilinear stencil and role lookup are
@@ -359,14 +360,14 @@ struct GroupSpans {
 
 }  // namespace
 
-WarpResult warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt) {
+WarpResult warp_cpu(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt) {
   WarpResult out;
   ReusableBuffer scratch;
-  warp_ref(mesh, src, box, opt, out, scratch);
+  warp_cpu(mesh, src, box, opt, out, scratch);
   return out;
 }
 
-void warp_ref(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt,
+void warp_cpu(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, const WarpOptions& opt,
               WarpResult& out, ReusableBuffer& scratch) {
   check_warp_mesh(mesh);
   PhaseTimer timer("warp on cpu");
