@@ -324,7 +324,7 @@ void write_nifti(const Volume& v, const std::string& path) {
   if (nifti_set_filenames(nim.get(), out.temp_path().c_str(), 0, 1) != 0)
     throw std::runtime_error(path + ": niftilib rejected the file name " + out.temp_path());
   nim->data = const_cast<void*>(v.raw());
-  // zlib level 1: about 3x faster than the default 6 on CT, files ~10 % larger. Returns nothing useful:
+  // zlib level 1: the fastest level (CT compresses little better at the default 6). Returns nothing useful:
   // check what it wrote.
   nifti_image_write_hdr_img(nim.get(), 1, "wb1");
   struct stat st {};

@@ -94,9 +94,9 @@ WarpResult warp_on_device(const std::string& device, const WarpMesh& mesh, const
 
 /// Warps one after another into memory kept between them: a time-lapse's frames, a benchmark's
 /// repetitions. The CPU warp of the peers' 512×512×300 case writes 400 MB of outputs and prepares
-/// 200 MB of tetrahedra; faulting that in anew costs 0.3 s or more per warp on the VMs here (seconds
-/// where the host has taken the pages back), a third of the warp or more, so a series faults it in once, as
-/// ITK's filters keep their output buffer between updates. (OpenCL warps allocate their own host outputs.)
+/// 200 MB of tetrahedra; faulting that in anew is a large share of a warp (measured in
+/// bench/results/2026-12-01-warp.md), so a series faults it in once, as ITK's filters keep their
+/// output buffer between updates. (OpenCL warps allocate their own host outputs.)
 class WarpSeries {
  public:
   /// warp_on_device; the result is valid until the next warp. After a throw the series holds none.
