@@ -59,6 +59,7 @@
 #include "mesh/mesh.h"
 #include "perf/bandwidth.h"
 #include "phantom/phantom.h"
+#include "pipeline/scene_stages.h"
 #include "roles/roles.h"
 #include "scene/scene.h"
 #include "solve/forces.h"

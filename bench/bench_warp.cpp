@@ -44,6 +44,7 @@
 #include "core/progress.h"
 #include "perf/bandwidth.h"
 #include "phantom/phantom.h"
+#include "pipeline/scene_stages.h"
 #include "roles/roles.h"
 #include "scene/scene.h"
 #include "solve/solver.h"

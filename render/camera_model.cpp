@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "core/error.h"
-#include "scene/scene.h"
+#include "render/view_settings.h"
 
 namespace pneumo {
 namespace {

@@ -18,7 +18,8 @@
 #include <optional>
 
 #include "core/geometry.h"
-#include "scene/scene_types.h"
+#include "domain/types.h"
+#include "render/view_settings.h"
 
 namespace pneumo {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "core/error.h"
-#include "scene/scene.h"
+#include "render/view_settings.h"
 
 namespace pneumo {
 

@@ -5,7 +5,8 @@
 #include <vector>
 
 #include "render/camera_model.h"
-#include "scene/scene_types.h"
+#include "domain/types.h"
+#include "render/view_settings.h"
 
 namespace pneumo {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
-#include "scene/scene.h"
+#include "render/view_settings.h"
 
 namespace pneumo {
 namespace {
@@ -117,7 +117,7 @@ TransferFunction preset_transfer_function(RenderPreset preset) {
   return tf;
 }
 
-TransferFunction scene_transfer_function(const SceneRender& render) {
+TransferFunction scene_transfer_function(const ViewSettings& render) {
   if (render.preset != RenderPreset::Custom) return preset_transfer_function(render.preset);
   TransferFunction tf;
   tf.name = "custom";

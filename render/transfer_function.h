@@ -9,7 +9,8 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "scene/scene_types.h"
+#include "domain/types.h"
+#include "render/view_settings.h"
 
 namespace pneumo {
 
@@ -33,7 +34,7 @@ TransferFunction preset_transfer_function(RenderPreset preset);
 
 /// The scene's choice: render.preset, or the points of render.custom_opacity / custom_colour
 /// when the preset is "custom".
-TransferFunction scene_transfer_function(const SceneRender& render);
+TransferFunction scene_transfer_function(const ViewSettings& render);
 
 /// The GL lookup table's HU range: 1 HU per entry from -2048 to 4095 (CT values beyond clamp).
 inline constexpr double kTfTableHuMin = -2048.0;

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/progress.h"
 #include "mesh/mesh.h"
+#include "pipeline/scene_stages.h"
 #include "scene/scene.h"
 #include "solve/contact.h"
 #include "solve/force_field.h"

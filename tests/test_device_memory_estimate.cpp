@@ -15,6 +15,7 @@
 #include "core/log.h"
 #include "core/progress.h"
 #include "opencl_test_support.h"
+#include "pipeline/scene_stages.h"
 #include "pipeline/simulate.h"
 #include "pipeline/warp_stage.h"
 #include "scene/scene.h"

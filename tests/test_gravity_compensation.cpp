@@ -14,6 +14,7 @@
 
 #include "core/progress.h"
 #include "mesh/mesh.h"
+#include "pipeline/scene_stages.h"
 #include "pipeline/simulate.h"
 #include "scene/scene.h"
 #include "solve/force_field.h"

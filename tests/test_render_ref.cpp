@@ -101,7 +101,7 @@ TEST(RenderTransferFunction, PresetsInterpolateTheirPointsAndCustomOnesAreChecke
   EXPECT_DOUBLE_EQ(m.opacity_at(5000), 0.804);  // constant beyond the last point
   EXPECT_DOUBLE_EQ(m.max_opacity(-1000, -200), 0.0);
   EXPECT_NEAR(m.max_opacity(0, 1000), 0.833, 1e-12);
-  SceneRender r;
+  ViewSettings r;
   r.preset = RenderPreset::Custom;
   r.custom_opacity = {-100, 0, 100, 1};
   r.custom_colour = {0, 1, 0, 0};

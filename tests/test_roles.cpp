@@ -11,6 +11,7 @@
 #include "core/progress.h"
 #include "io/volume_io.h"
 #include "io_test_support.h"
+#include "pipeline/scene_stages.h"
 #include "report/slices.h"
 #include "roles/pad.h"
 #include "roles/roles.h"

@@ -13,6 +13,7 @@
 
 #include "core/progress.h"
 #include "phantom/phantom.h"
+#include "pipeline/scene_stages.h"
 #include "roles/roles.h"
 #include "scene/scene.h"
 

@@ -10,6 +10,7 @@
 
 #include "core/progress.h"
 #include "io/volume_io.h"
+#include "pipeline/scene_stages.h"
 #include "roles/roles.h"
 #include "scene/scene.h"
 #include "shared_data.h"

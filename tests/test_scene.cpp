@@ -473,7 +473,7 @@ TEST(SceneRules, Queries) {
                                     {"unlisted_label_role", "viscera"}}},
                          {"material", {{"young_kpa", 50}, {"wall_young_kpa", 24}, {"label_young_kpa", json::array({{{"label", 6}, {"young_kpa", 3}}})}}}},
                         kOrigin);
-  const std::vector<Role> roles = s.label_roles();
+  const std::vector<Role> roles = s.roles.label_roles();
   ASSERT_EQ(roles.size(), 65536u);
   EXPECT_EQ(roles[2], Role::Wall);
   EXPECT_EQ(roles[5], Role::Viscera);

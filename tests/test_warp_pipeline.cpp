@@ -18,6 +18,7 @@
 #include "io/volume_io.h"
 #include "mesh/deformation_file.h"
 #include "opencl_test_support.h"
+#include "pipeline/scene_stages.h"
 #include "pipeline/warp_stage.h"
 #include "warp_test_support.h"
 
@@ -129,7 +130,7 @@ TEST_F(WarpPipeline, ThePhantomAt12MmHgOpensAGasCavityBetweenWallAndViscera) {
   EXPECT_LT(ml, 2.0 * mesh_ml);
 
   const Scene scene = load_scene(path("case/scene.json"));
-  const std::vector<Role> role_of = scene.label_roles();
+  const std::vector<Role> role_of = scene.roles.label_roles();
   const Index3 d = lab.geometry().dims;
   ASSERT_EQ(lab.geometry().direction(1, 1), 1.0);   // the phantom's j axis points anterior
   int64_t gas = 0, between = 0;

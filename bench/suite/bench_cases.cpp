@@ -1,3 +1,4 @@
+#include "pipeline/scene_stages.h"
 #include "suite/bench_cases.h"
 
 #include <chrono>

@@ -1,3 +1,4 @@
+#include "pipeline/scene_stages.h"
 #include "suite/material_models.h"
 
 #include <algorithm>

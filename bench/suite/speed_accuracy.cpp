@@ -1,3 +1,4 @@
+#include "pipeline/scene_stages.h"
 #include "suite/speed_accuracy.h"
 
 #include <algorithm>

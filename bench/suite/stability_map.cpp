@@ -1,3 +1,4 @@
+#include "pipeline/scene_stages.h"
 #include "suite/stability_map.h"
 
 #include <chrono>

@@ -1,3 +1,4 @@
+#include "pipeline/scene_stages.h"
 #include "suite/throughput.h"
 
 #include <algorithm>
@@ -159,7 +160,7 @@ RenderVolume render_volume(const BenchCase& c, const WarpResult& w) {
 
 /// The scene's first camera; else an anterior exterior view of the volume's centre from 400 mm.
 ViewCamera bench_camera(const BenchCase& c, int width, int height) {
-  const SceneRender& r = c.scene.render;
+  const ViewSettings& r = c.scene.render;
   if (!r.cameras.empty()) {
     const Camera& cam = r.cameras.front();
     return make_view_camera(look_at_pose(cam.position_mm, cam.look_at_mm, cam.optics.up), cam.optics, width, height);

@@ -5,6 +5,7 @@
 #include "cli/commands.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "pipeline/scene_stages.h"
 #include "report/role_png.h"
 #include "roles/roles.h"
 #include "scene/scene.h"

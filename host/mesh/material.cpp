@@ -2,8 +2,6 @@
 #include <cmath>
 
 #include "mesh/mesh.h"
-#include "scene/scene.h"
-#include "scene/scene_presets.h"
 
 namespace pneumo {
 
@@ -32,25 +30,6 @@ void assign_material(Mesh& m, const MaterialOptions& opt) {
     const double mass = 0.5 * (m.mass_kg[m.springs[s][0]] + m.mass_kg[m.springs[s][1]]);
     m.spring_c[s] = 2.0 * opt.damping_ratio * std::sqrt(mass * m.spring_k[s]);
   }
-}
-
-Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene) {
-  MeshOptions opt;
-  opt.cube_voxels = cube_voxels_for(scene.mesh, roles.geometry);
-  opt.model = scene.mesh.model;
-  opt.roi_min_mm = scene.mesh.roi_min_mm;
-  opt.roi_max_mm = scene.mesh.roi_max_mm;
-  Mesh m = build_mesh(roles, opt,
-                      VoxelYoungFn([&](Role r, int label, float hu) { return scene.young_kpa_for(r, label, hu) * 1e3; }));
-  m.tet_poisson.resize(m.tets.size());
-  for (std::size_t t = 0; t < m.tets.size(); ++t)
-    m.tet_poisson[t] = scene.poisson_for(m.tet_part[t] == Part::Wall ? Role::Wall : Role::Viscera, m.tet_label[t]);
-  MaterialOptions mat;
-  mat.density_kg_m3 = scene.material.density_kg_m3;
-  mat.damping_ratio = scene.material.damping_ratio;
-  mat.spring_scale = scene.material.spring_scale;
-  assign_material(m, mat);
-  return m;
 }
 
 }  // namespace pneumo

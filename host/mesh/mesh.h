@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "scene/scene_types.h"
+#include "domain/types.h"
 
 namespace pneumo {
 
@@ -142,9 +142,6 @@ std::vector<Vec3> displacements(const Mesh& m, const std::vector<Vec3>& x);
 /// which is the face's area vector in the tetrahedron's own frame, the same in every rest shape the
 /// tissue maps to (Nanson). Throws std::runtime_error when a tetrahedron would be inside out.
 Mesh with_rest_shape(const Mesh& m, const std::vector<Vec3>& rest_m);
-
-/// The mesh of a scene's roles, with its material assigned.
-Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene);
 
 struct MaterialOptions {
   double density_kg_m3 = 1096.0;

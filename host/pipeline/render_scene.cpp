@@ -12,6 +12,7 @@
 #include "core/log.h"
 #include "core/progress.h"
 #include "io/volume_io.h"
+#include "pipeline/scene_stages.h"
 #include "render/camera_path.h"
 #include "render/image_out.h"
 #include "render/ray_cast_gl.h"
@@ -73,7 +74,7 @@ nlohmann::json pose_json(const ViewCamera& c) {
 
 }  // namespace
 
-RenderSettings settings_from_scene(const SceneRender& r, const Geometry& g) {
+RenderSettings settings_from_scene(const ViewSettings& r, const Geometry& g) {
   RenderSettings s;
   s.tf = scene_transfer_function(r);
   s.step_mm = r.step_fraction * g.spacing_mm.minCoeff();  // §8: at most half the smallest spacing
@@ -107,7 +108,7 @@ bool encode_mp4(const fs::path& frame_dir, const fs::path& mp4) {
 }
 
 RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
-  const SceneRender& r = scene.render;
+  const ViewSettings& r = scene.render;
   RenderRun run;
   const fs::path out(opt.out_dir);
   const fs::path deformed_ct = out / "deformed_ct.nii.gz", deformed_labels = out / "deformed_labels.nii.gz";
@@ -138,7 +139,7 @@ RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
 RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Volume& ct, const Volume* labels,
                          RenderRun run) {
   const auto start = std::chrono::steady_clock::now();
-  const SceneRender& r = scene.render;
+  const ViewSettings& r = scene.render;
   const fs::path out(opt.out_dir);
   const fs::path deformed_labels = out / "deformed_labels.nii.gz";
   const PointMapFn map = opt.map_point ? opt.map_point : identity_point_map();

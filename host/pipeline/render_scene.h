@@ -51,7 +51,7 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& options, const
 
 /// The ray caster's settings from a scene's render section, for a volume on grid `g` (the step is
 /// render.step_fraction of its smallest spacing).
-RenderSettings settings_from_scene(const SceneRender& r, const Geometry& g);
+RenderSettings settings_from_scene(const ViewSettings& r, const Geometry& g);
 
 /// Whether ffmpeg is on PATH, and frames frame_0001.png … in `frame_dir` → `mp4` (H.264, 25 frames/s,
 /// written beside and renamed; false with a warning when ffmpeg fails).

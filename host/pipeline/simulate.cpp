@@ -15,6 +15,7 @@
 #include "cl/cl_runtime.h"
 #include "mesh/deformation_file.h"
 #include "mesh/vtu_writer.h"
+#include "pipeline/scene_stages.h"
 #include "report/plot_svg.h"
 #include "solve/gravity_compensation.h"
 #include "solve/solvable.h"

@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 Timelapse::Timelapse(const Scene& scene, const Simulation& sim, const std::string& out_dir, GlBackend backend)
     : scene_(scene), preview_(scene), sim_(sim), out_dir_(out_dir), backend_(backend),
       ct_grid_(unpadded_geometry(sim.roles.geometry, sim.roles.pad)), labels_(!scene.inputs.labels.empty()) {
-  SceneRender& r = preview_.render;
+  ViewSettings& r = preview_.render;
   r.paths.clear();
   if (!r.cameras.empty()) {
     r.cameras.resize(1);

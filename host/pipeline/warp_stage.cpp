@@ -13,6 +13,7 @@
 #include "core/units.h"
 #include "io/volume_io.h"
 #include "image/png.h"
+#include "pipeline/scene_stages.h"
 #include "report/slices.h"
 #include "roles/connected_components.h"
 #include "warp/cavity_specks.h"

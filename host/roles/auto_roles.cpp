@@ -12,7 +12,7 @@
 #include "roles/distance_transform.h"
 #include "roles/label_map.h"
 #include "roles/lateral_to_bone.h"
-#include "scene/scene.h"
+#include "roles/role_rules.h"
 
 namespace pneumo {
 
@@ -40,14 +40,10 @@ class StageTimer {
 };
 
 /// Rules 1-3: labels, outside, bone. Everything else stays undecided.
-std::vector<Role> decide_by_labels_and_hu(const SceneRoles& r, const std::vector<uint8_t>& body, const float* hu,
+std::vector<Role> decide_by_labels_and_hu(const RoleRules& r, const std::vector<uint8_t>& body, const float* hu,
                                           const uint16_t* label) {
   const int64_t n = int64_t(body.size());
-  const std::vector<Role> table = [&] {
-    Scene s;
-    s.roles = r;
-    return s.label_roles();
-  }();
+  const std::vector<Role> table = r.label_roles();
   const std::vector<uint8_t> listed = listed_label_ids(r);
   const bool use_labels = r.auto_use_labels && label != nullptr;
   const float bone = float(r.auto_bone_threshold_hu);
@@ -85,7 +81,7 @@ void fix_the_back(std::vector<Role>& role, const std::vector<uint8_t>& body, con
 
 /// Rule 5: the shell, wall anterior and lateral, fixed behind.
 void assign_the_shell(std::vector<Role>& role, const std::vector<uint8_t>& body, const std::vector<SliceCentre>& centres,
-                      const SliceFrame& f, const Geometry& g, const SceneRoles& r) {
+                      const SliceFrame& f, const Geometry& g, const RoleRules& r) {
   const std::vector<float> depth_mm = distance_to_outside_mm(body, g);
   const float thickness = float(r.auto_wall_thickness_mm);
   const double cos_max = std::cos(r.auto_wall_max_angle_deg * M_PI / 180.0);
@@ -109,7 +105,7 @@ void assign_the_shell(std::vector<Role>& role, const std::vector<uint8_t>& body,
 }
 
 /// Rule 5b: undecided voxels anterior to a prevesical label in the same axial column → wall.
-void attach_prevesical_space(std::vector<Role>& role, const uint16_t* label, const SliceFrame& f, const SceneRoles& r) {
+void attach_prevesical_space(std::vector<Role>& role, const uint16_t* label, const SliceFrame& f, const RoleRules& r) {
   if (!label || r.auto_prevesical_labels.empty()) return;
   std::vector<uint8_t> listed(65536, 0);
   for (int id : r.auto_prevesical_labels) listed[std::size_t(id)] = 1;
@@ -129,7 +125,7 @@ void attach_prevesical_space(std::vector<Role>& role, const uint16_t* label, con
 
 /// Rule 6: undecided voxels lateral to bone (away from the midline) → fixed.
 void fix_lateral_to_bone(std::vector<Role>& role, const std::vector<uint8_t>& body, const float* hu,
-                         const std::vector<SliceCentre>& centres, const SliceFrame& f, const SceneRoles& r) {
+                         const std::vector<SliceCentre>& centres, const SliceFrame& f, const RoleRules& r) {
   const int64_t n = int64_t(role.size());
   std::vector<uint8_t> bone(static_cast<std::size_t>(n)), undecided(static_cast<std::size_t>(n));
   const float bone_hu = float(r.auto_bone_threshold_hu);
@@ -146,7 +142,7 @@ void fix_lateral_to_bone(std::vector<Role>& role, const std::vector<uint8_t>& bo
 
 }  // namespace
 
-std::vector<Role> auto_roles(const SceneRoles& r, const Geometry& g, const float* hu, const uint16_t* label) {
+std::vector<Role> auto_roles(const RoleRules& r, const Geometry& g, const float* hu, const uint16_t* label) {
   Progress progress("roles", 6);
   StageTimer timer(progress);
   const SliceFrame f = slice_frame(g);

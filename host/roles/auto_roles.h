@@ -41,11 +41,12 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "scene/scene_types.h"
+#include "domain/types.h"
+#include "roles/role_rules.h"
 
 namespace pneumo {
 
 /// Roles on grid `g` from `hu` (HU, i fastest) and, when not null, `label` on the same grid.
-std::vector<Role> auto_roles(const SceneRoles& rules, const Geometry& g, const float* hu, const uint16_t* label);
+std::vector<Role> auto_roles(const RoleRules& rules, const Geometry& g, const float* hu, const uint16_t* label);
 
 }  // namespace pneumo

@@ -5,9 +5,18 @@
 
 #include "core/error.h"
 #include "core/log.h"
-#include "scene/scene.h"
 
 namespace pneumo {
+
+std::vector<Role> RoleRules::label_roles() const {
+  std::vector<Role> table(65536, unlisted_label_role);
+  // The lists cannot overlap (checked when the scene is read), so the order here does not matter.
+  for (int id : wall_labels) table[id] = Role::Wall;
+  for (int id : viscera_labels) table[id] = Role::Viscera;
+  for (int id : fixed_labels) table[id] = Role::Fixed;
+  for (int id : other_labels) table[id] = Role::Other;
+  return table;
+}
 
 namespace {
 
@@ -79,14 +88,14 @@ std::vector<Role> roles_from_labels(const std::vector<uint16_t>& label, const st
   return role;
 }
 
-std::vector<uint8_t> listed_label_ids(const SceneRoles& r) {
+std::vector<uint8_t> listed_label_ids(const RoleRules& r) {
   std::vector<uint8_t> listed(65536, 0);
   for (const auto* list : {&r.wall_labels, &r.viscera_labels, &r.fixed_labels, &r.other_labels})
     for (int id : *list) listed[std::size_t(id)] = 1;
   return listed;
 }
 
-void note_label_coverage(const SceneRoles& r, const std::vector<uint16_t>& label, const std::string& labels_name) {
+void note_label_coverage(const RoleRules& r, const std::vector<uint16_t>& label, const std::string& labels_name) {
   std::vector<uint8_t> present(65536, 0);
   for (uint16_t id : label) present[id] = 1;  // a byte store per voxel: cheap next to reading the file
   const std::vector<uint8_t> listed = listed_label_ids(r);

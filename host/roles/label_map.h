@@ -1,13 +1,14 @@
 #pragma once
 // The label map as roles see it: checked to lie on the CT's grid, its ids checked to be whole
-// numbers 0..65535, mapped to roles through the scene's lists (Scene::label_roles()).
+// numbers 0..65535, mapped to roles through the scene's lists (RoleRules::label_roles()).
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "core/geometry.h"
 #include "io/volume.h"
-#include "scene/scene_types.h"
+#include "domain/types.h"
+#include "roles/role_rules.h"
 
 namespace pneumo {
 
@@ -27,9 +28,9 @@ std::vector<Role> roles_from_labels(const std::vector<uint16_t>& label, const st
 /// (a typo in a scene shows up here). A wall, viscera or fixed list none of whose ids the map holds
 /// is an InputError naming the list and the ids the map does hold (a mapping for another label map). Ids the map holds that no list names get
 /// unlisted_label_role: an info line names them.
-void note_label_coverage(const SceneRoles& roles, const std::vector<uint16_t>& label, const std::string& labels_name);
+void note_label_coverage(const RoleRules& roles, const std::vector<uint16_t>& label, const std::string& labels_name);
 
 /// Whether each id 0..65535 is in one of the scene's role lists.
-std::vector<uint8_t> listed_label_ids(const SceneRoles& roles);
+std::vector<uint8_t> listed_label_ids(const RoleRules& roles);
 
 }  // namespace pneumo

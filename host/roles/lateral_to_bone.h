@@ -8,7 +8,7 @@
 
 #include "roles/anatomical_axes.h"
 #include "roles/body_mask.h"
-#include "scene/scene_types.h"
+#include "domain/types.h"
 
 namespace pneumo {
 

@@ -3,11 +3,11 @@
 #include <string>
 
 #include "roles/anatomical_axes.h"
-#include "scene/scene.h"
+#include "roles/role_rules.h"
 
 namespace pneumo {
 
-PadMm pad_mm_of(const SceneRoles& r) {
+PadMm pad_mm_of(const RoleRules& r) {
   return {r.pad_anterior_mm, r.pad_lateral_mm, r.pad_superior_mm, r.pad_inferior_mm};
 }
 

@@ -8,22 +8,10 @@
 #include "io/volume_io.h"
 #include "roles/auto_roles.h"
 #include "roles/label_map.h"
-#include "scene/scene.h"
 
 namespace pneumo {
 
 namespace {
-
-std::string scene_name(const Scene& s) { return s.path.empty() ? std::string("scene") : s.path; }
-std::string ct_name(const Scene& s) { return s.inputs.ct.empty() ? std::string("(CT)") : s.inputs.ct; }
-std::string labels_name(const Scene& s) { return s.inputs.labels.empty() ? std::string("(label map)") : s.inputs.labels; }
-
-void require_labels_if_needed(const Scene& s, bool have_labels) {
-  if (s.roles.source == RoleSource::Labels && !have_labels)
-    throw InputError(scene_name(s) +
-                     ": roles.source is \"labels\" but inputs.labels is not given; give a label map or set "
-                     "roles.source to \"auto\"");
-}
 
 /// HU rules, padding and the warp all compare and interpolate HU values: a NaN or infinite voxel would
 /// silently take a role by accident and spread through interpolation. Refused, naming the first.
@@ -71,36 +59,34 @@ double RoleVolume::voxel_volume_ml() const {
   return geometry.spacing_mm[0] * geometry.spacing_mm[1] * geometry.spacing_mm[2] / 1000.0;
 }
 
-RoleVolume assign_roles(const Scene& scene, const Volume& ct, const Volume* labels) {
-  require_labels_if_needed(scene, labels != nullptr);
-  ct.geometry().validate(ct_name(scene));
-  check_finite_ct(ct, ct_name(scene));
+void require_labels_if_needed(const RoleRules& rules, bool have_labels, const RoleInputNames& names) {
+  if (rules.source == RoleSource::Labels && !have_labels)
+    throw InputError(names.scene +
+                     ": roles.source is \"labels\" but inputs.labels is not given; give a label map or set "
+                     "roles.source to \"auto\"");
+}
+
+RoleVolume assign_roles(const RoleRules& rules, const Volume& ct, const Volume* labels, const RoleInputNames& names) {
+  require_labels_if_needed(rules, labels != nullptr, names);
+  ct.geometry().validate(names.ct);
+  check_finite_ct(ct, names.ct);
   if (labels) {
-    check_labels_on_ct_grid(ct.geometry(), labels->geometry(), ct_name(scene), labels_name(scene));
-    check_label_values(*labels, labels_name(scene));
+    check_labels_on_ct_grid(ct.geometry(), labels->geometry(), names.ct, names.labels);
+    check_label_values(*labels, names.labels);
   }
   RoleVolume rv;
-  rv.pad = pad_voxels(ct.geometry(), pad_mm_of(scene.roles));
+  rv.pad = pad_voxels(ct.geometry(), pad_mm_of(rules));
   rv.geometry = padded_geometry(ct.geometry(), rv.pad);
   rv.ct = padded_ct_float(ct, rv.pad);
   rv.label = padded_labels(labels, ct.geometry(), rv.pad);
-  if (labels) note_label_coverage(scene.roles, rv.label, labels_name(scene));
+  if (labels) note_label_coverage(rules, rv.label, names.labels);
 
-  if (scene.roles.source == RoleSource::Labels) {
-    rv.role = roles_from_labels(rv.label, scene.label_roles());
+  if (rules.source == RoleSource::Labels) {
+    rv.role = roles_from_labels(rv.label, rules.label_roles());
   } else {
-    rv.role = auto_roles(scene.roles, rv.geometry, rv.ct.data<float>(), labels ? rv.label.data() : nullptr);
+    rv.role = auto_roles(rules, rv.geometry, rv.ct.data<float>(), labels ? rv.label.data() : nullptr);
   }
   return rv;
-}
-
-RoleVolume load_roles(const Scene& scene) {
-  const bool have_labels = !scene.inputs.labels.empty();
-  require_labels_if_needed(scene, have_labels);   // before reading a large CT for nothing
-  const Volume ct = read_volume(scene.require_ct());
-  if (!have_labels) return assign_roles(scene, ct, nullptr);
-  const Volume labels = read_volume(scene.inputs.labels);
-  return assign_roles(scene, ct, &labels);
 }
 
 }  // namespace pneumo

@@ -9,7 +9,8 @@
 #include "core/geometry.h"
 #include "io/volume.h"
 #include "roles/pad.h"
-#include "scene/scene_types.h"
+#include "domain/types.h"
+#include "roles/role_rules.h"
 
 namespace pneumo {
 
@@ -31,13 +32,18 @@ struct RoleVolume {
   double volume_ml(Role r) const { return double(count(r)) * voxel_volume_ml(); }
 };
 
-/// Roles of a case from its CT and (may be null) its label map, which must be on the CT's grid.
-/// roles.source "labels": role = Scene::label_roles()[label]; "auto": auto_roles.h's rules.
-/// InputError (naming the files from scene.inputs) for a missing label map in labels mode, a label
-/// map off the CT's grid, or label values that are not ids 0..65535.
-RoleVolume assign_roles(const Scene& scene, const Volume& ct, const Volume* labels);
+/// What messages call the inputs: the scene file and the CT's and label map's files.
+struct RoleInputNames {
+  std::string scene = "scene", ct = "(CT)", labels = "(label map)";
+};
 
-/// Reads inputs.ct (and inputs.labels when given), then assign_roles.
-RoleVolume load_roles(const Scene& scene);
+/// Roles of a case from its CT and (may be null) its label map, which must be on the CT's grid.
+/// source "labels": role = rules.label_roles()[label]; "auto": auto_roles.h's rules.
+/// InputError (naming the files) for a missing label map in labels mode, a label map off the CT's
+/// grid, or label values that are not ids 0..65535. The scene's form is in pipeline/scene_stages.h.
+RoleVolume assign_roles(const RoleRules& rules, const Volume& ct, const Volume* labels, const RoleInputNames& names);
+
+/// InputError when `rules` need a label map and none is given (before reading a large CT for nothing).
+void require_labels_if_needed(const RoleRules& rules, bool have_labels, const RoleInputNames& names);
 
 }  // namespace pneumo

@@ -16,7 +16,9 @@
 #include <nlohmann/json.hpp>
 
 #include "core/geometry.h"
-#include "scene/scene_types.h"
+#include "domain/types.h"
+#include "render/view_settings.h"
+#include "roles/role_rules.h"
 
 namespace pneumo {
 
@@ -25,25 +27,6 @@ namespace pneumo {
 struct SceneInputs {
   std::string ct;       // "" = not given; see Scene::require_ct()
   std::string labels;   // "" = not given
-};
-
-struct SceneRoles {
-  RoleSource source = RoleSource::Labels;
-  std::vector<int> wall_labels, viscera_labels, fixed_labels, other_labels;
-  Role unlisted_label_role = Role::Other;
-  // Automatic extraction (§2, option). Limits: a single body (largest component), bone by HU only
-  // (contrast-filled vessels above the threshold become fixed too), wall thickness uniform.
-  double auto_body_threshold_hu = -500.0;  // air/lung < -500 < fat (about -100)
-  double auto_bone_threshold_hu = 250.0;   // above soft tissue and enhanced vessels in most scans
-  double auto_wall_thickness_mm = 30.0;    // skin + fat + muscle of an adult abdomen
-  double auto_wall_max_angle_deg = 100.0;  // anterior (0) and lateral (90) sides; the back is not
-  bool auto_use_labels = true;
-  // Extraperitoneal organs whose front the peritoneum does not reach (the bladder: the space of
-  // Retzius lies between it and the wall): undecided tissue anterior to them in the same axial
-  // column becomes wall, so no gas opens there (auto_roles.h, rule 5b).
-  std::vector<int> auto_prevesical_labels;
-  // Air added around the CT so the wall has room to rise (a 12 mmHg abdomen rises 30-60 mm).
-  double pad_anterior_mm = 0.0, pad_lateral_mm = 0.0, pad_superior_mm = 0.0, pad_inferior_mm = 0.0;
 };
 
 struct SceneMesh {
@@ -117,64 +100,6 @@ struct SceneSolver {
   double rayleigh_stiffness_s = 0.1;
 };
 
-/// Optics shared by cameras, ports and paths (§8).
-struct Optics {
-  Vec3 up = Vec3(0.0, 0.0, 1.0);  // superior (RAS+ world)
-  double fov_deg = 70.0;
-  Lens lens = Lens::Pinhole;
-  double oblique_deg = 0.0;
-  double roll_deg = 0.0;
-  double near_mm = 1.0;
-};
-
-struct Camera {
-  std::string name;
-  Vec3 position_mm = Vec3::Zero();
-  Vec3 look_at_mm = Vec3::Zero();
-  Optics optics;
-};
-
-/// A trocar port on the skin, carried through the deformation, aimed at a point or an organ.
-struct Port {
-  std::string name;
-  Vec3 skin_point_mm = Vec3::Zero();
-  std::optional<Vec3> target_mm;   // exactly one of target_mm, target_label
-  std::optional<int> target_label;
-  double insertion_mm = 40.0;      // tip beyond the skin point, along the port axis
-  Optics optics;
-};
-
-struct Keyframe {
-  Vec3 position_mm = Vec3::Zero();
-  Vec3 look_at_mm = Vec3::Zero();
-};
-
-struct CameraPath {
-  std::string name;
-  int frames = 60;
-  std::vector<Keyframe> keyframes;  // at least 2
-  Optics optics;
-};
-
-struct SceneRender {
-  int width = 640, height = 480;
-  RenderPreset preset = RenderPreset::Laparoscopic;
-  double step_fraction = 0.5;     // §8: step ≤ half the smallest spacing
-  bool jitter = false;            // off: images are reproducible
-  bool show_labels = true;
-  double label_opacity = 0.5;
-  double light_falloff_mm = 100.0;  // d0 of the headlight's 1/(1+(d/d0)²) (§8)
-  // Phong coefficients; VTK's defaults for volumes lit by a headlight (ambient low: the scope's
-  // own light is the only light in the abdomen).
-  double ambient = 0.15, diffuse = 0.85, specular = 0.25, shininess = 12.0;
-  // preset "custom": Slicer-style flat lists [HU, α, HU, α, ...] and [HU, r, g, b, ...].
-  std::vector<double> custom_opacity, custom_colour;
-  bool exterior_views = true;     // anterior and left views from outside with CT-Air (§8)
-  std::vector<Camera> cameras;
-  std::vector<Port> ports;
-  std::vector<CameraPath> paths;
-};
-
 struct SceneOutput {
   std::string folder;             // "" = the command line decides
   bool write_meshes = false;
@@ -207,13 +132,13 @@ struct Scene {
   std::string name, description;
   ScenePreset preset = ScenePreset::None;   // applied while parsing: see scene_presets.h
   SceneInputs inputs;
-  SceneRoles roles;
+  RoleRules roles;
   SceneMesh mesh;
   SceneMaterial material;
   SceneLoad load;
   SceneSolver solver;
   std::string device = "cpu";     // "cpu", "opencl" or "opencl:P:D"
-  SceneRender render;
+  ViewSettings render;
   SceneOutput output;
   std::vector<Landmark> landmarks;
 
@@ -226,9 +151,6 @@ struct Scene {
 
   /// inputs.ct; throws InputError naming the scene when it is not given.
   const std::string& require_ct() const;
-
-  /// Role of every label id 0..65535 (index = id): the role lists, else unlisted_label_role.
-  std::vector<Role> label_roles() const;
 
   /// Young's modulus of a tetrahedron (kPa): label_young_kpa for its label, else the role's
   /// override (wall_young_kpa, viscera_young_kpa), else young_kpa.

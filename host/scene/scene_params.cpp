@@ -77,41 +77,41 @@ const Table<SceneInputs>& inputs_table() {
   return t;
 }
 
-const Table<SceneRoles>& roles_table() {
+const Table<RoleRules>& roles_table() {
   const Constraint ids = in(0, kMaxLabel);
   const Constraint pad = in(0, 500);
-  static const Table<SceneRoles> t{
-      {"source", &SceneRoles::source, "", any(),
+  static const Table<RoleRules> t{
+      {"source", &RoleRules::source, "", any(),
        "Where roles come from (§2): \"labels\" = the role lists below; \"auto\" = extracted from the CT's HU."},
-      {"wall_labels", &SceneRoles::wall_labels, "", ids,
+      {"wall_labels", &RoleRules::wall_labels, "", ids,
        "Label ids of the abdominal wall (skin, fat, muscle). A label id may be in one list only."},
-      {"viscera_labels", &SceneRoles::viscera_labels, "", ids,
+      {"viscera_labels", &RoleRules::viscera_labels, "", ids,
        "Label ids of organs and everything inside the peritoneum that moves."},
-      {"fixed_labels", &SceneRoles::fixed_labels, "", ids, "Label ids that do not move: bone, back, table."},
-      {"other_labels", &SceneRoles::other_labels, "", ids, "Label ids left out of the simulation."},
-      {"unlisted_label_role", &SceneRoles::unlisted_label_role, "", any(),
+      {"fixed_labels", &RoleRules::fixed_labels, "", ids, "Label ids that do not move: bone, back, table."},
+      {"other_labels", &RoleRules::other_labels, "", ids, "Label ids left out of the simulation."},
+      {"unlisted_label_role", &RoleRules::unlisted_label_role, "", any(),
        "Role of label ids in none of the lists (label 0, background, included unless listed)."},
-      {"auto_body_threshold_hu", &SceneRoles::auto_body_threshold_hu, "HU", in(-1024, 3071),
+      {"auto_body_threshold_hu", &RoleRules::auto_body_threshold_hu, "HU", in(-1024, 3071),
        "auto: voxels above this are body (air and lung below); its largest connected part is kept."},
-      {"auto_bone_threshold_hu", &SceneRoles::auto_bone_threshold_hu, "HU", in(-1024, 3071),
+      {"auto_bone_threshold_hu", &RoleRules::auto_bone_threshold_hu, "HU", in(-1024, 3071),
        "auto: body voxels above this are fixed (bone; contrast-filled vessels above it too)."},
-      {"auto_wall_thickness_mm", &SceneRoles::auto_wall_thickness_mm, "mm", above(0, 200),
+      {"auto_wall_thickness_mm", &RoleRules::auto_wall_thickness_mm, "mm", above(0, 200),
        "auto: wall = body voxels within this distance of the skin, on the sides given by auto_wall_max_angle_deg."},
-      {"auto_wall_max_angle_deg", &SceneRoles::auto_wall_max_angle_deg, "deg", in(0, 180),
+      {"auto_wall_max_angle_deg", &RoleRules::auto_wall_max_angle_deg, "deg", in(0, 180),
        "auto: the shell is wall where the skin faces within this angle of anterior (90 = lateral); "
        "the rest of the shell (the back, on the table) is fixed, the body inside it viscera."},
-      {"auto_use_labels", &SceneRoles::auto_use_labels, "", any(),
+      {"auto_use_labels", &RoleRules::auto_use_labels, "", any(),
        "auto with a label map: voxels whose label is in a role list keep that role; HU rules fill in the rest."},
-      {"auto_prevesical_labels", &SceneRoles::auto_prevesical_labels, "", ids,
+      {"auto_prevesical_labels", &RoleRules::auto_prevesical_labels, "", ids,
        "auto with a label map: undecided tissue anterior to these labels in the same axial column becomes wall "
        "(the space of Retzius in front of the bladder is extraperitoneal: no gas opens there). TotalSegmentator: "
        "[21]."},
-      {"pad_anterior_mm", &SceneRoles::pad_anterior_mm, "mm", pad,
+      {"pad_anterior_mm", &RoleRules::pad_anterior_mm, "mm", pad,
        "Air added in front of the CT so the wall has room to rise (a real CT cropped at the skin needs >= 60)."},
-      {"pad_lateral_mm", &SceneRoles::pad_lateral_mm, "mm", pad,
+      {"pad_lateral_mm", &RoleRules::pad_lateral_mm, "mm", pad,
        "Air added on the left and on the right (>= 60 for a CT cropped at the skin)."},
-      {"pad_superior_mm", &SceneRoles::pad_superior_mm, "mm", pad, "Air added above the CT (head side)."},
-      {"pad_inferior_mm", &SceneRoles::pad_inferior_mm, "mm", pad, "Air added below the CT (feet side)."},
+      {"pad_superior_mm", &RoleRules::pad_superior_mm, "mm", pad, "Air added above the CT (head side)."},
+      {"pad_inferior_mm", &RoleRules::pad_inferior_mm, "mm", pad, "Air added below the CT (feet side)."},
   };
   return t;
 }
@@ -333,35 +333,35 @@ const Table<CameraPath>& path_table() {
   return t;
 }
 
-const Table<SceneRender>& render_table() {
-  static const Table<SceneRender> t{
-      {"width", &SceneRender::width, "px", in(16, 8192), "Image width."},
-      {"height", &SceneRender::height, "px", in(16, 8192), "Image height."},
-      {"preset", &SceneRender::preset, "", any(),
+const Table<ViewSettings>& render_table() {
+  static const Table<ViewSettings> t{
+      {"width", &ViewSettings::width, "px", in(16, 8192), "Image width."},
+      {"height", &ViewSettings::height, "px", in(16, 8192), "Image height."},
+      {"preset", &ViewSettings::preset, "", any(),
        "Transfer function (§8): \"laparoscopic\" (flesh tones, gas clear), one of 3D Slicer's CT presets, or "
        "\"custom\" (the two lists below)."},
-      {"custom_opacity", &SceneRender::custom_opacity, "", any().rule("pairs [HU, opacity 0 to 1], HU non-decreasing", is_opacity_points),
+      {"custom_opacity", &ViewSettings::custom_opacity, "", any().rule("pairs [HU, opacity 0 to 1], HU non-decreasing", is_opacity_points),
        "Preset \"custom\": opacity per 1 mm of ray at HU points, [HU, α, HU, α, ...]; linear between, constant beyond."},
-      {"custom_colour", &SceneRender::custom_colour, "", any().rule("quadruples [HU, r, g, b], components 0 to 1, HU non-decreasing", is_colour_points),
+      {"custom_colour", &ViewSettings::custom_colour, "", any().rule("quadruples [HU, r, g, b], components 0 to 1, HU non-decreasing", is_colour_points),
        "Preset \"custom\": colours at HU points, [HU, r, g, b, ...]."},
-      {"ambient", &SceneRender::ambient, "", in(0, 1), "Phong ambient coefficient (light present without the headlight)."},
-      {"diffuse", &SceneRender::diffuse, "", in(0, 1), "Phong diffuse coefficient (headlight, CT gradient normals)."},
-      {"specular", &SceneRender::specular, "", in(0, 1), "Phong specular coefficient (white highlights)."},
-      {"shininess", &SceneRender::shininess, "", in(1, 1000), "Phong specular exponent."},
-      {"exterior_views", &SceneRender::exterior_views, "", any(),
+      {"ambient", &ViewSettings::ambient, "", in(0, 1), "Phong ambient coefficient (light present without the headlight)."},
+      {"diffuse", &ViewSettings::diffuse, "", in(0, 1), "Phong diffuse coefficient (headlight, CT gradient normals)."},
+      {"specular", &ViewSettings::specular, "", in(0, 1), "Phong specular coefficient (white highlights)."},
+      {"shininess", &ViewSettings::shininess, "", in(1, 1000), "Phong specular exponent."},
+      {"exterior_views", &ViewSettings::exterior_views, "", any(),
        "Also render the abdomen from outside (anterior and left) with CT-Air: the gas cavity as a surface (§8)."},
-      {"step_fraction", &SceneRender::step_fraction, "", above(0, 0.5),
+      {"step_fraction", &ViewSettings::step_fraction, "", above(0, 0.5),
        "Ray step as a fraction of the smallest voxel spacing (§8: at most half)."},
-      {"jitter", &SceneRender::jitter, "", any(), "Offset each ray's start randomly (hides wood-grain bands; images then vary)."},
-      {"show_labels", &SceneRender::show_labels, "", any(),
+      {"jitter", &ViewSettings::jitter, "", any(), "Offset each ray's start randomly (hides wood-grain bands; images then vary)."},
+      {"show_labels", &ViewSettings::show_labels, "", any(),
        "Blend organ label colours over the CT colour (§8) when a label map is given."},
-      {"label_opacity", &SceneRender::label_opacity, "", in(0, 1), "Opacity of the label colours."},
-      {"light_falloff_mm", &SceneRender::light_falloff_mm, "mm", above(0, 10000),
+      {"label_opacity", &ViewSettings::label_opacity, "", in(0, 1), "Opacity of the label colours."},
+      {"light_falloff_mm", &ViewSettings::light_falloff_mm, "mm", above(0, 10000),
        "d0 of the headlight: intensity 1/(1+(d/d0)²) at distance d from the tip (§8)."},
-      {"cameras", &SceneRender::cameras, camera_table(), any().items(0, 256), "Views given by tip and aim."},
-      {"ports", &SceneRender::ports, port_table(), any().items(0, 256),
+      {"cameras", &ViewSettings::cameras, camera_table(), any().items(0, 256), "Views given by tip and aim."},
+      {"ports", &ViewSettings::ports, port_table(), any().items(0, 256),
        "Views from trocar ports on the skin, aimed at a point or an organ."},
-      {"paths", &SceneRender::paths, path_table(), any().items(0, 64), "Fly-throughs along keyframes."},
+      {"paths", &ViewSettings::paths, path_table(), any().items(0, 64), "Fly-throughs along keyframes."},
   };
   return t;
 }

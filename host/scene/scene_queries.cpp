@@ -12,16 +12,6 @@ const std::string& Scene::require_ct() const {
   return inputs.ct;
 }
 
-std::vector<Role> Scene::label_roles() const {
-  std::vector<Role> table(65536, roles.unlisted_label_role);
-  // The lists cannot overlap (checked when the scene is read), so the order here does not matter.
-  for (int id : roles.wall_labels) table[id] = Role::Wall;
-  for (int id : roles.viscera_labels) table[id] = Role::Viscera;
-  for (int id : roles.fixed_labels) table[id] = Role::Fixed;
-  for (int id : roles.other_labels) table[id] = Role::Other;
-  return table;
-}
-
 double Scene::young_kpa_for(Role role, int label) const {
   for (const LabelYoung& l : material.label_young_kpa)
     if (l.label == label) return l.young_kpa;

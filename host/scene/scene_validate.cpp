@@ -14,7 +14,7 @@ namespace {
 json vec_json(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
 
 // Each label id has one role: a label in two lists would make the role depend on list order.
-void check_role_lists(const SceneRoles& r, const At& roles) {
+void check_role_lists(const RoleRules& r, const At& roles) {
   const std::vector<std::pair<const char*, const std::vector<int>*>> lists{
       {"wall_labels", &r.wall_labels},
       {"viscera_labels", &r.viscera_labels},
@@ -104,7 +104,7 @@ void check_lens(const Optics& o, const At& optics) {
 }
 
 // Preset "custom" needs its points; other presets ignore them, which would surprise: say so.
-void check_transfer_function(const SceneRender& r, const At& render) {
+void check_transfer_function(const ViewSettings& r, const At& render) {
   const bool custom = r.preset == RenderPreset::Custom;
   const bool given = !r.custom_opacity.empty() || !r.custom_colour.empty();
   if (custom && (r.custom_opacity.empty() || r.custom_colour.empty()))
@@ -114,7 +114,7 @@ void check_transfer_function(const SceneRender& r, const At& render) {
                                                            "\"custom\" to use them");
 }
 
-void check_views(const SceneRender& r, const At& render) {
+void check_views(const ViewSettings& r, const At& render) {
   std::map<std::string, std::string> names;  // name → path of the view that has it
   const auto claim = [&](const std::string& name, const At& view) {
     if (r.exterior_views && name.rfind("exterior_", 0) == 0)

@@ -5,7 +5,6 @@
 
 #include "core/error.h"
 #include "core/units.h"
-#include "scene/scene.h"
 #include "solve/solver_common.h"
 
 namespace pneumo {
@@ -51,40 +50,6 @@ double ramp_factor(double t_s, double ramp_s, RampShape shape) {
   if (!(ramp_s > 0.0) || t_s >= ramp_s) return 1.0;
   const double tau = std::max(0.0, t_s / ramp_s);
   return shape == RampShape::Linear ? tau : 0.5 * (1.0 - std::cos(M_PI * tau));
-}
-
-SolveOptions solve_options_from_scene(const Scene& s) {
-  SolveOptions o;
-  o.method = s.solver.method;
-  o.forces.material = s.material.model;
-  o.forces.mean_dilatation = s.material.mean_dilatation;
-  o.forces.spring_model = s.material.spring_model;
-  o.forces.stiffening = s.material.stiffening;
-  o.forces.pressure_pa = units::mmhg_to_pa(s.load.pressure_mmhg);
-  o.forces.volume_stiffness_pa = units::kpa_to_pa(s.effective_volume_stiffness_kpa());
-  // Supine, down is posterior (−y in RAS); tilted head down by θ, sin θ of it points to the head (+z).
-  const double tilt = s.material.tilt_deg * (3.14159265358979323846 / 180.0);
-  if (s.material.gravity) o.forces.gravity_m_s2 = 9.81 * Vec3(0, -std::cos(tilt), std::sin(tilt));
-  if (s.material.contact) o.forces.contact_stiffness = s.material.contact_stiffness;
-  o.dt_s = units::ms_to_s(s.solver.dt_ms);
-  o.dt_safety = s.solver.dt_safety;
-  o.max_steps = s.solver.max_steps;
-  o.residual_tolerance = s.solver.residual_tolerance;
-  o.velocity_tolerance_m_s = s.solver.velocity_tolerance_mm_s * units::kMetresPerMm;
-  o.hold_steps = s.solver.hold_steps;
-  o.ramp_s = units::ms_to_s(s.load.ramp_ms);
-  o.ramp_shape = s.load.ramp_shape;
-  o.newmark_beta = s.solver.newmark_beta;
-  o.newmark_gamma = s.solver.newmark_gamma;
-  o.newmark_inner_tolerance = s.solver.newmark_inner_tolerance;
-  o.newmark_max_inner = s.solver.newmark_max_inner;
-  o.newton_max_cg_iterations = s.solver.newton_max_cg_iterations;
-  o.rayleigh_mass_per_s = s.solver.rayleigh_mass_per_s;
-  o.rayleigh_stiffness_s = s.solver.rayleigh_stiffness_s;
-  o.kitasaka_step = s.solver.kitasaka_step;
-  o.kitasaka_tolerance_m = s.solver.kitasaka_tolerance_mm * units::kMetresPerMm;
-  o.on_inverted = s.solver.on_inverted;
-  return o;
 }
 
 SolveResult solve(const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x_start) {

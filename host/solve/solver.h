@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "mesh/mesh.h"
-#include "scene/scene_types.h"
+#include "domain/types.h"
 #include "solve/forces.h"
 
 namespace pneumo {
@@ -52,9 +52,6 @@ struct SolveOptions {
   std::function<void(const SolverSnapshot&)> on_snapshot;
   bool progress = true;
 };
-
-/// The options a scene asks for (units converted to SI).
-SolveOptions solve_options_from_scene(const Scene& scene);
 
 struct SolveSample {              // one row of the convergence history
   int64_t step = 0;

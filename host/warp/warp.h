@@ -27,7 +27,7 @@
 
 #include "cl/cl_runtime.h"
 #include "core/reusable_buffer.h"
-#include "scene/scene_types.h"
+#include "domain/types.h"
 #include "warp/warp_mesh.h"
 
 namespace pneumo {

@@ -15,7 +15,7 @@
 #endif
 
 #include "core/geometry.h"
-#include "scene/scene_types.h"
+#include "domain/types.h"
 
 namespace pneumo {
 

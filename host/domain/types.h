@@ -1,7 +1,7 @@
 #pragma once
-// The scene's named values and the names of its sections, without the sections themselves: what the
-// stage headers (roles, mesh, solve, warp, render) need, so that they do not depend on the whole scene
-// type (scene.h defines the sections; issue "One shape for every stage").
+// The domain's named values: roles, models, methods, lenses, presets, and how scene files spell
+// them. The bottom layer every stage shares (roles, mesh, solve, warp, render), so that none of
+// them depends on the scene (scene.h composes the stages' settings into a scene file's sections).
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -81,13 +81,5 @@ template <class E> const char* enum_name(E e) {
   return EnumNames<E>::names[static_cast<std::size_t>(e)];
 }
 inline const char* role_name(Role r) { return enum_name(r); }
-
-// ---- sections, declared (scene.h defines them) ---------------------------------------------------
-
-struct Scene;
-struct SceneRoles;
-struct SceneRender;
-struct Optics;
-struct Keyframe;
 
 }  // namespace pneumo

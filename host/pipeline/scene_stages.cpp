@@ -1,0 +1,89 @@
+#include "pipeline/scene_stages.h"
+
+#include <cmath>
+
+#include "core/units.h"
+#include "io/volume_io.h"
+#include "scene/scene_presets.h"
+
+namespace pneumo {
+
+namespace {
+
+RoleInputNames input_names(const Scene& s) {
+  RoleInputNames n;
+  if (!s.path.empty()) n.scene = s.path;
+  if (!s.inputs.ct.empty()) n.ct = s.inputs.ct;
+  if (!s.inputs.labels.empty()) n.labels = s.inputs.labels;
+  return n;
+}
+
+}  // namespace
+
+RoleVolume assign_roles(const Scene& scene, const Volume& ct, const Volume* labels) {
+  return assign_roles(scene.roles, ct, labels, input_names(scene));
+}
+
+RoleVolume load_roles(const Scene& scene) {
+  const bool have_labels = !scene.inputs.labels.empty();
+  require_labels_if_needed(scene.roles, have_labels, input_names(scene));   // before reading a large CT for nothing
+  const Volume ct = read_volume(scene.require_ct());
+  if (!have_labels) return assign_roles(scene, ct, nullptr);
+  const Volume labels = read_volume(scene.inputs.labels);
+  return assign_roles(scene, ct, &labels);
+}
+
+Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene) {
+  MeshOptions opt;
+  opt.cube_voxels = cube_voxels_for(scene.mesh, roles.geometry);
+  opt.model = scene.mesh.model;
+  opt.roi_min_mm = scene.mesh.roi_min_mm;
+  opt.roi_max_mm = scene.mesh.roi_max_mm;
+  Mesh m = build_mesh(roles, opt,
+                      VoxelYoungFn([&](Role r, int label, float hu) { return scene.young_kpa_for(r, label, hu) * 1e3; }));
+  m.tet_poisson.resize(m.tets.size());
+  for (std::size_t t = 0; t < m.tets.size(); ++t)
+    m.tet_poisson[t] = scene.poisson_for(m.tet_part[t] == Part::Wall ? Role::Wall : Role::Viscera, m.tet_label[t]);
+  MaterialOptions mat;
+  mat.density_kg_m3 = scene.material.density_kg_m3;
+  mat.damping_ratio = scene.material.damping_ratio;
+  mat.spring_scale = scene.material.spring_scale;
+  assign_material(m, mat);
+  return m;
+}
+
+SolveOptions solve_options_from_scene(const Scene& s) {
+  SolveOptions o;
+  o.method = s.solver.method;
+  o.forces.material = s.material.model;
+  o.forces.mean_dilatation = s.material.mean_dilatation;
+  o.forces.spring_model = s.material.spring_model;
+  o.forces.stiffening = s.material.stiffening;
+  o.forces.pressure_pa = units::mmhg_to_pa(s.load.pressure_mmhg);
+  o.forces.volume_stiffness_pa = units::kpa_to_pa(s.effective_volume_stiffness_kpa());
+  // Supine, down is posterior (−y in RAS); tilted head down by θ, sin θ of it points to the head (+z).
+  const double tilt = s.material.tilt_deg * (3.14159265358979323846 / 180.0);
+  if (s.material.gravity) o.forces.gravity_m_s2 = 9.81 * Vec3(0, -std::cos(tilt), std::sin(tilt));
+  if (s.material.contact) o.forces.contact_stiffness = s.material.contact_stiffness;
+  o.dt_s = units::ms_to_s(s.solver.dt_ms);
+  o.dt_safety = s.solver.dt_safety;
+  o.max_steps = s.solver.max_steps;
+  o.residual_tolerance = s.solver.residual_tolerance;
+  o.velocity_tolerance_m_s = s.solver.velocity_tolerance_mm_s * units::kMetresPerMm;
+  o.hold_steps = s.solver.hold_steps;
+  o.ramp_s = units::ms_to_s(s.load.ramp_ms);
+  o.ramp_shape = s.load.ramp_shape;
+  o.newmark_beta = s.solver.newmark_beta;
+  o.newmark_gamma = s.solver.newmark_gamma;
+  o.newmark_inner_tolerance = s.solver.newmark_inner_tolerance;
+  o.newmark_max_inner = s.solver.newmark_max_inner;
+  o.newton_max_cg_iterations = s.solver.newton_max_cg_iterations;
+  o.rayleigh_mass_per_s = s.solver.rayleigh_mass_per_s;
+  o.rayleigh_stiffness_s = s.solver.rayleigh_stiffness_s;
+  o.kitasaka_step = s.solver.kitasaka_step;
+  o.kitasaka_tolerance_m = s.solver.kitasaka_tolerance_mm * units::kMetresPerMm;
+  o.on_inverted = s.solver.on_inverted;
+  return o;
+}
+
+}  // namespace pneumo

@@ -1,0 +1,25 @@
+#pragma once
+// The one place a scene becomes what each stage takes: the stages (roles, mesh, solve) know their
+// own options and nothing of the scene file (the build enforces it: cmake/Layers.cmake); these
+// read a scene's sections, convert units to the stages' (SI inside), and call them.
+#include "mesh/mesh.h"
+#include "roles/roles.h"
+#include "scene/scene.h"
+#include "solve/solver.h"
+
+namespace pneumo {
+
+/// roles.* and the inputs' names for messages, then assign_roles (roles/roles.h).
+RoleVolume assign_roles(const Scene& scene, const Volume& ct, const Volume* labels);
+
+/// Reads inputs.ct (and inputs.labels when given), then assign_roles.
+RoleVolume load_roles(const Scene& scene);
+
+/// The mesh of a case: mesh.* (the cube size from the CT's spacing when mesh.cube_mm is set),
+/// material.* per role, label and HU (Scene::young_kpa_for, poisson_for), masses and springs.
+Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene);
+
+/// The options a scene asks for (units converted to SI).
+SolveOptions solve_options_from_scene(const Scene& scene);
+
+}  // namespace pneumo

@@ -1,0 +1,32 @@
+#pragma once
+// How voxels become roles (method.md §2): the scene's "roles" section. By label lists, or by the
+// automatic HU rules (auto_roles.h) with their thresholds, and the air padded around the CT (pad.h).
+#include <vector>
+
+#include "domain/types.h"
+
+namespace pneumo {
+
+struct RoleRules {
+  RoleSource source = RoleSource::Labels;
+  std::vector<int> wall_labels, viscera_labels, fixed_labels, other_labels;
+  Role unlisted_label_role = Role::Other;
+  // Automatic extraction (§2, option). Limits: a single body (largest component), bone by HU only
+  // (contrast-filled vessels above the threshold become fixed too), wall thickness uniform.
+  double auto_body_threshold_hu = -500.0;  // air/lung < -500 < fat (about -100)
+  double auto_bone_threshold_hu = 250.0;   // above soft tissue and enhanced vessels in most scans
+  double auto_wall_thickness_mm = 30.0;    // skin + fat + muscle of an adult abdomen
+  double auto_wall_max_angle_deg = 100.0;  // anterior (0) and lateral (90) sides; the back is not
+  bool auto_use_labels = true;
+  // Extraperitoneal organs whose front the peritoneum does not reach (the bladder: the space of
+  // Retzius lies between it and the wall): undecided tissue anterior to them in the same axial
+  // column becomes wall, so no gas opens there (auto_roles.h, rule 5b).
+  std::vector<int> auto_prevesical_labels;
+  // Air added around the CT so the wall has room to rise (a 12 mmHg abdomen rises 30-60 mm).
+  double pad_anterior_mm = 0.0, pad_lateral_mm = 0.0, pad_superior_mm = 0.0, pad_inferior_mm = 0.0;
+
+  /// Role of every label id 0..65535 (index = id): the role lists, else unlisted_label_role.
+  std::vector<Role> label_roles() const;
+};
+
+}  // namespace pneumo
