@@ -23,7 +23,7 @@
 #include "core/progress.h"
 #include "phantom/phantom.h"
 #include "render/image_out.h"
-#include "render/ray_cast_gl.h"
+#include "render/renderer.h"
 #include "render/ray_cast_ref.h"
 #include "scene/scene.h"
 
@@ -120,12 +120,12 @@ RenderSettings lap_settings(double step_mm) {
 
 double g_setup_s = 0;  // shader compile + volume upload with its gradients (VTK's "setup_s" counterpart)
 
-GlRayCaster& gl_caster() {
-  static std::unique_ptr<GlRayCaster> gl;
+Renderer& gl_caster() {   // the render stage's GL path
+  static std::unique_ptr<Renderer> gl;
   if (!gl) {
     bench();
     const auto t0 = std::chrono::steady_clock::now();
-    gl = std::make_unique<GlRayCaster>(shared_gl_context());
+    gl = std::make_unique<Renderer>(false, GlBackend::Auto);
     gl->set_volume(bench().volume);
     g_setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
@@ -135,7 +135,7 @@ GlRayCaster& gl_caster() {
 // args: width, height, step in µm, 0 = laparoscopic preset / 1 = VTK's transfer function
 void BM_RenderGl(benchmark::State& state) {
   const Bench& b = bench();
-  GlRayCaster& gl = gl_caster();
+  Renderer& gl = gl_caster();
   ViewCamera cam = b.camera;
   cam.width = int(state.range(0));
   cam.height = int(state.range(1));
@@ -173,9 +173,11 @@ void BM_RenderCpuReference(benchmark::State& state) {
   cam.height = int(state.range(1));
   const double step = state.range(2) / 1000.0;
   const RenderSettings s = state.range(3) ? vtk_like_settings(step) : lap_settings(step);
+  Renderer reference(true, GlBackend::Auto);
+  reference.set_volume(b.volume);
   RenderImage im;
   for (auto _ : state) {
-    im = render_reference(b.volume, cam, s);
+    im = reference.render(cam, s);
     benchmark::DoNotOptimize(im.rgba.data());
   }
   state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);

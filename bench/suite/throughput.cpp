@@ -14,8 +14,7 @@
 #include "pipeline/render_scene.h"
 #include "render/camera_model.h"
 #include "render/gl_context.h"
-#include "render/ray_cast_gl.h"
-#include "render/ray_cast_ref.h"
+#include "render/renderer.h"
 #include "render/render_volume.h"
 #include "render/transfer_function.h"
 #include "solve/forces_cl.h"
@@ -201,11 +200,11 @@ json measure_case_throughput(BenchContext& ctx, const BenchCase& c, int pipeline
   const int width = ctx.quick() ? 128 : c.scene.render.width, height = ctx.quick() ? 96 : c.scene.render.height;
   const ViewCamera camera = bench_camera(c, width, height);
   const RenderSettings settings = settings_from_scene(c.scene.render, c.ct.geometry());
-  std::unique_ptr<GlRayCaster> gl;
+  std::unique_ptr<Renderer> gl;   // the stage's GL path
   std::string gl_renderer;
   try {
-    gl = std::make_unique<GlRayCaster>(shared_gl_context());
-    gl_renderer = shared_gl_context().info().renderer;
+    gl = std::make_unique<Renderer>(false, GlBackend::Auto);
+    gl_renderer = gl->describe().value("gl_renderer", "");
   } catch (const std::exception& e) {
     ctx.note(c.name + ": no OpenGL context, frames not rendered (" + e.what() + ")");
   }
@@ -241,7 +240,8 @@ json measure_case_throughput(BenchContext& ctx, const BenchCase& c, int pipeline
         double frame = 0;
         if (gl) {
           t0 = Clock::now();
-          gl->set_volume(render_volume(c, w));
+          const RenderVolume volume = render_volume(c, w);
+          gl->set_volume(volume);
           gl->render(camera, settings);
           frame = seconds_since(t0);
         }
@@ -285,7 +285,8 @@ json measure_case_throughput(BenchContext& ctx, const BenchCase& c, int pipeline
   // quarter of the size (it is the checking oracle, not a fast path).
   json render;
   if (gl && !last_warp.ct_hu.empty()) {
-    gl->set_volume(render_volume(c, last_warp));
+    const RenderVolume volume = render_volume(c, last_warp);
+    gl->set_volume(volume);
     gl->render(camera, settings);
     const int frames = ctx.quick() ? 2 : 4;
     const CpuSample c0 = cpu_sample();
@@ -300,7 +301,9 @@ json measure_case_throughput(BenchContext& ctx, const BenchCase& c, int pipeline
     for (const Device& d : ctx.devices()) {
       if (d.opencl()) continue;
       Summary s;
-      with_threads(d.threads, [&] { s = time_reps(ctx.quick() ? 1 : 2, 0, [&] { render_reference(v, small, settings); }); });
+      Renderer reference(true, GlBackend::Auto);
+      reference.set_volume(v);
+      with_threads(d.threads, [&] { s = time_reps(ctx.quick() ? 1 : 2, 0, [&] { reference.render(small, settings); }); });
       cpu.push_back({{"device", d.name}, {"width", small.width}, {"height", small.height},
                      {"frames_per_s", rate_json(s, 1)}});
     }

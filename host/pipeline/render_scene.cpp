@@ -15,8 +15,7 @@
 #include "pipeline/scene_stages.h"
 #include "render/camera_path.h"
 #include "render/image_out.h"
-#include "render/ray_cast_gl.h"
-#include "render/ray_cast_ref.h"
+#include "render/renderer.h"
 #include "roles/label_map.h"
 
 namespace pneumo {
@@ -30,33 +29,6 @@ std::string show(const Vec3& v) {
   std::snprintf(b, sizeof b, "[%.1f, %.1f, %.1f]", v.x(), v.y(), v.z());
   return b;
 }
-
-
-// The GL ray caster or the CPU reference behind one call.
-class Renderer {
- public:
-  explicit Renderer(const RenderOptions& o) : cpu_(o.cpu_reference) {
-    if (!cpu_) gl_ = std::make_unique<GlRayCaster>(shared_gl_context(o.backend));
-  }
-  void set_volume(const RenderVolume& v) {
-    volume_ = &v;
-    if (gl_) gl_->set_volume(v);
-  }
-  RenderImage render(const ViewCamera& c, const RenderSettings& s) {
-    return gl_ ? gl_->render(c, s) : render_reference(*volume_, c, s);
-  }
-  nlohmann::json describe() const {
-    if (!gl_) return {{"renderer", "cpu-reference"}};
-    const GlContextInfo& i = shared_gl_context().info();
-    return {{"renderer", "opengl"},        {"backend", gl_backend_name(i.backend)}, {"gl_version", i.version},
-            {"gl_renderer", i.renderer},   {"gl_vendor", i.vendor},                 {"hu_texture", gl_->hu_format()}};
-  }
-
- private:
-  bool cpu_;
-  std::unique_ptr<GlRayCaster> gl_;
-  const RenderVolume* volume_ = nullptr;
-};
 
 void require_inside(const RenderVolume& v, const Vec3& tip, const std::string& what) {
   if (v.contains(tip)) return;
@@ -190,7 +162,7 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Vol
   for (const Path& p : paths) total += int64_t(p.cameras.size());
   if (total == 0) throw InputError("the scene's render section has no cameras, ports, paths or exterior views");
 
-  Renderer renderer(opt);
+  Renderer renderer(opt.cpu_reference, opt.backend);
   fs::create_directories(out / "views");
   renderer.set_volume(volume);
   nlohmann::json view_report = nlohmann::json::array();
