@@ -47,6 +47,7 @@
 #include "pipeline/scene_stages.h"
 #include "roles/roles.h"
 #include "scene/scene.h"
+#include "solve/solve_on_device.h"
 #include "solve/solver.h"
 #include "warp/warp.h"
 
@@ -88,7 +89,7 @@ const WarpCase& warp_case() {
   const Phantom ph = make_phantom(size);
   c->roles = assign_roles(scene, ph.ct, &ph.labels);
   const Mesh mesh = build_scene_mesh(VoxelRoles{c->roles.geometry, c->roles.role.data(), c->roles.label.data(), c->roles.hu()}, scene);
-  const SolveResult r = solve(mesh, solve_options_from_scene(scene));
+  const SolveResult r = solve_on_device(nullptr, mesh, solve_options_from_scene(scene));
   log::set_level(level);
   std::vector<Vec3> u(r.x.size());
   for (std::size_t n = 0; n < u.size(); ++n) u[n] = r.x[n] - mesh.rest_m[n];

@@ -1,4 +1,5 @@
 #include "pipeline/scene_stages.h"
+#include "solve/solve_on_device.h"
 #include "suite/speed_accuracy.h"
 
 #include <algorithm>
@@ -113,7 +114,7 @@ Solved run_config(const BenchCase& c, const Config& cfg, double limit_s) {
   };
   Solved s;
   try {
-    s.result = solve(c.mesh, opt);
+    s.result = solve_on_device(nullptr, c.mesh, opt);
   } catch (const TimeLimit&) {
     s.timed_out = true;
   } catch (const DivergedError& e) {

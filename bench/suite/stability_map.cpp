@@ -1,4 +1,5 @@
 #include "pipeline/scene_stages.h"
+#include "solve/solve_on_device.h"
 #include "suite/stability_map.h"
 
 #include <chrono>
@@ -26,7 +27,7 @@ bool stable(const Mesh& mesh, SolveOptions opt, double dt_s, int steps) {
   opt.velocity_tolerance_m_s = 1e-12;
   opt.progress = false;
   try {
-    const SolveResult r = solve(mesh, opt);
+    const SolveResult r = solve_on_device(nullptr, mesh, opt);
     for (const Vec3& x : r.x)
       if (!x.allFinite()) return false;
     return true;
