@@ -50,7 +50,7 @@ std::map<int, int64_t> label_counts(const Phantom& p) {
 
 double voxel_ml(const Phantom& p) { return p.labels.geometry().spacing_mm.prod() / 1000.0; }
 
-std::set<int> ids_with_role(const std::string& role) {
+std::set<int> ids_with_role(Role role) {
   std::set<int> s;
   for (const PhantomLabel& l : phantom_labels())
     if (l.role == role) s.insert(l.id);
@@ -124,13 +124,12 @@ TEST(PhantomLabels, TotalSegmentatorIdsRolesAndSources) {
   const auto& labels = phantom_labels();
   ASSERT_FALSE(labels.empty());
   EXPECT_EQ(labels.front().id, 0);
-  EXPECT_EQ(labels.front().role, "other");
+  EXPECT_EQ(labels.front().role, Role::Other);
   std::set<int> ids;
   std::set<std::string> names;
   for (const PhantomLabel& l : labels) {
     EXPECT_TRUE(ids.insert(l.id).second) << "duplicate id " << l.id;
     EXPECT_TRUE(names.insert(l.name).second) << "duplicate name " << l.name;
-    EXPECT_TRUE(l.role == "wall" || l.role == "viscera" || l.role == "fixed" || l.role == "other") << l.name;
     EXPECT_GE(l.id, 0);
     EXPECT_LE(l.id, 255);
     EXPECT_FALSE(l.source.empty()) << l.name;
@@ -147,12 +146,12 @@ TEST(PhantomLabels, TotalSegmentatorIdsRolesAndSources) {
       {"abdominal_wall_muscle", 202}, {"intraperitoneal_fat", 203}, {"ct_table", 204}};
   for (const auto& [name, id] : expected) EXPECT_EQ(id_of(name), id) << name;
   // Roles as method.md §2 assigns them.
-  for (const char* w : {"skin", "subcutaneous_fat", "abdominal_wall_muscle"}) EXPECT_EQ(label_named(w).role, "wall");
+  for (const char* w : {"skin", "subcutaneous_fat", "abdominal_wall_muscle"}) EXPECT_EQ(label_named(w).role, Role::Wall);
   for (const char* v : {"liver", "spleen", "kidney_left", "kidney_right", "stomach", "small_bowel", "colon", "aorta",
                         "inferior_vena_cava", "intraperitoneal_fat"})
-    EXPECT_EQ(label_named(v).role, "viscera") << v;
+    EXPECT_EQ(label_named(v).role, Role::Viscera) << v;
   for (const char* f : {"vertebrae_L3", "rib_left_10", "autochthon_left", "ct_table"})
-    EXPECT_EQ(label_named(f).role, "fixed") << f;
+    EXPECT_EQ(label_named(f).role, Role::Fixed) << f;
 }
 
 // ---- determinism -------------------------------------------------------------------------------------------------
@@ -240,7 +239,7 @@ TEST_P(PhantomBySize, AnteriorWallAlongTheMidlineIs20To40mm) {
   // between the pelvic brim and the xiphoid.
   const Phantom& p = phantom(GetParam());
   const Geometry& g = p.labels.geometry();
-  const std::set<int> wall = ids_with_role("wall");
+  const std::set<int> wall = ids_with_role(Role::Wall);
   const uint8_t* l = p.labels.data<uint8_t>();
   const int64_t i0 = index_near(g, 0, 0.0);
   int checked = 0;
@@ -330,7 +329,7 @@ TEST_P(PhantomBySize, WallEnclosesTheCavity) {
   const Geometry& g = p.labels.geometry();
   const uint8_t* l = p.labels.data<uint8_t>();
   std::array<bool, 256> viscera{};
-  for (int id : ids_with_role("viscera")) viscera[id] = true;
+  for (int id : ids_with_role(Role::Viscera)) viscera[id] = true;
   int64_t touching = 0, viscera_voxels = 0;
   const int64_t nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
   for (int64_t k = 0; k < nz; ++k)
@@ -392,10 +391,10 @@ TEST(PhantomScene, JsonFollowsTheSchemaAndTheLabelTable) {
     const auto& roles = j.at("roles");
     EXPECT_EQ(roles.at("source"), "labels");
     EXPECT_EQ(roles.at("unlisted_label_role"), "other");
-    for (const auto& [key, role] : std::map<std::string, std::string>{{"wall_labels", "wall"},
-                                                                      {"viscera_labels", "viscera"},
-                                                                      {"fixed_labels", "fixed"},
-                                                                      {"other_labels", "other"}}) {
+    for (const auto& [key, role] : std::map<std::string, Role>{{"wall_labels", Role::Wall},
+                                                               {"viscera_labels", Role::Viscera},
+                                                               {"fixed_labels", Role::Fixed},
+                                                               {"other_labels", Role::Other}}) {
       std::set<int> listed;
       for (const auto& v : roles.at(key)) listed.insert(v.get<int>());
       EXPECT_EQ(listed, ids_with_role(role)) << key;

@@ -37,7 +37,7 @@ Run add_phantom(CLI::App& app) {
     for (const auto& l : phantom_labels()) {
       const auto it = labels.label_voxels.find(l.id);
       const double ml = it == labels.label_voxels.end() ? 0.0 : double(it->second) * labels.voxel_volume_ml;
-      std::printf("  %5d  %-24s %-8s %8.0f %10.1f\n", l.id, l.name.c_str(), l.role.c_str(), l.hu, ml);
+      std::printf("  %5d  %-24s %-8s %8.0f %10.1f\n", l.id, l.name.c_str(), role_name(l.role), l.hu, ml);
     }
     return 0;
   };

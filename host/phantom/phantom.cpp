@@ -119,9 +119,9 @@ std::string phantom_scene_json(PhantomSize size) {
   nlohmann::ordered_json wall = nlohmann::ordered_json::array(), viscera = nlohmann::ordered_json::array(),
                          fixed = nlohmann::ordered_json::array(), other = nlohmann::ordered_json::array();
   for (const PhantomLabel& l : phantom_labels()) {
-    if (l.role == "wall") wall.push_back(l.id);
-    else if (l.role == "viscera") viscera.push_back(l.id);
-    else if (l.role == "fixed") fixed.push_back(l.id);
+    if (l.role == Role::Wall) wall.push_back(l.id);
+    else if (l.role == Role::Viscera) viscera.push_back(l.id);
+    else if (l.role == Role::Fixed) fixed.push_back(l.id);
     else other.push_back(l.id);
   }
   const std::string name = std::string("phantom-") + phantom_size_name(size);

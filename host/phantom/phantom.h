@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/geometry.h"
+#include "domain/types.h"
 #include "io/volume.h"
 
 namespace pneumo {
@@ -27,7 +28,7 @@ const char* phantom_size_name(PhantomSize size);
 struct PhantomLabel {
   int id;
   std::string name;     // TotalSegmentator class name where one exists
-  std::string role;     // "wall", "viscera", "fixed" or "other" (method.md §2)
+  Role role;            // method.md §2
   double hu;            // nominal (noise-free) HU of the tissue
   std::string source;   // where the HU value comes from
 };
