@@ -23,11 +23,7 @@ using namespace pneumo::testing_support;
 
 namespace {
 
-WarpOptions options() {
-  WarpOptions o;
-  o.cavity_label = 250;
-  return o;
-}
+WarpOptions options() { return warp_test_options(); }
 
 class WarpCpu : public ::testing::Test {
  protected:

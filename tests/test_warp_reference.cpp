@@ -25,20 +25,8 @@ using namespace pneumo::testing_support;
 
 namespace {
 
-WarpOptions options() {
-  WarpOptions o;
-  o.cavity_label = 250;
-  return o;
-}
-
-Geometry oblique_grid() {
-  Geometry g;
-  g.dims = {24, 24, 20};
-  g.spacing_mm = Vec3(0.8, 0.8, 1.6);
-  g.direction = Eigen::AngleAxisd(0.3, Vec3(1, 1, 0).normalized()).toRotationMatrix();
-  g.origin_mm = Vec3(-20, 35, -110);
-  return g;
-}
+WarpOptions options() { return warp_test_options(); }
+Geometry oblique_grid() { return oblique_test_grid(); }
 
 class WarpReference : public ::testing::Test {
  protected:
@@ -91,46 +79,16 @@ TEST_F(WarpReference, TheFastCpuWarpEqualsItOnRandomDeformationsExceptAtMeasured
   for (const Trial trial : {Trial{51, 4, 0.0}, Trial{52, 3, 0.0}, Trial{53, 4, 1.6}, Trial{54, 3, 1.6, true}}) {
     SCOPED_TRACE("seed " + std::to_string(trial.seed));
     const WarpCase c = make_warp_case(oblique_grid(), trial.cube, trial.seed);
-    std::mt19937 rng(trial.seed);
-    std::uniform_real_distribution<double> jitter(-0.35, 0.35);
-    std::vector<Vec3> u(std::size_t(c.mesh.node_count()));
-    for (int64_t n = 0; n < c.mesh.node_count(); ++n) {
-      const Vec3 x = c.grid.to_index(1e3 * c.mesh.rest_m[n]);
-      const Vec3 smooth = c.mesh.node_part[n] == Part::Wall
-                              ? Vec3(0.4 * std::cos(x[2] / 3.0), 2.5 + std::sin(x[0] / 5.0) - 2.5 * trial.toward, 0)
-                              : Vec3(0, -0.8 + trial.toward, 0.5 * std::sin(x[1] / 4.0));
-      u[std::size_t(n)] = 1e-3 * (c.index_to_mm() * (smooth + Vec3(jitter(rng), jitter(rng), jitter(rng))));
-    }
-    WarpMesh m = make_warp_mesh(c.mesh, u);
-    if (trial.reversed) {
-      std::reverse(m.tets.begin(), m.tets.end());
-      std::reverse(m.tet_part.begin(), m.tet_part.end());
-    }
+    const WarpMesh m = random_warp_mesh(c, trial.seed, trial.toward, trial.reversed);
     const WarpBox box{{1, 2, 1}, {22, 21, 18}};   // like a CT inside its padding
     const WarpResult ref = warp_reference(m, c.source(), box, options());
     const WarpResult fast = warp_cpu(m, c.source(), box, options());
-    ASSERT_EQ(ref.ct_hu.size(), fast.ct_hu.size());
-    int64_t ties = 0, untied = 0, both = 0;
-    double worst = 0.0;
-    for (int64_t k = 0; k < box.dims[2]; ++k)
-      for (int64_t j = 0; j < box.dims[1]; ++j)
-        for (int64_t i = 0; i < box.dims[0]; ++i) {
-          const std::size_t n = std::size_t(i + box.dims[0] * (j + box.dims[1] * k));
-          if (ref.outcome[n] == WarpOutcome::Carried && fast.outcome[n] == WarpOutcome::Carried) {
-            ++both;
-            worst = std::max(worst, std::abs(double(ref.ct_hu[n]) - double(fast.ct_hu[n])));
-          } else if (ref.outcome[n] == fast.outcome[n]) {
-            EXPECT_EQ(ref.ct_hu[n], fast.ct_hu[n]);   // gas or the voxel's own value: no arithmetic
-          }
-          if (ref.outcome[n] == fast.outcome[n] && ref.labels[n] == fast.labels[n]) continue;
-          if (measured_tie(m, Vec3(double(i + box.lo[0]), double(j + box.lo[1]), double(k + box.lo[2])))) ++ties;
-          else ++untied;
-        }
-    EXPECT_GT(both, 2000);
+    const WarpComparison cmp = compare_warps(ref, fast, m, box);
+    EXPECT_GT(cmp.both_carried, 2000);
     EXPECT_GT(ref.gas_voxels, 0);
-    EXPECT_LE(worst, 1e-3) << "max CT difference (HU)";
-    EXPECT_EQ(untied, 0) << "voxels whose outcome or label differ without a tie";
+    EXPECT_LE(cmp.worst_hu, 1e-3) << "max CT difference (HU)";
+    EXPECT_EQ(cmp.untied, 0) << "voxels whose outcome or label differ without a tie";
     std::printf("seed %u: %lld voxels carried by both, max |dHU| %.2e, %lld tie mismatches\n", trial.seed,
-                (long long)both, worst, (long long)ties);
+                (long long)cmp.both_carried, cmp.worst_hu, (long long)cmp.ties);
   }
 }

@@ -225,4 +225,72 @@ inline bool measured_tie(const WarpMesh& m, const Vec3& p) {
   return false;
 }
 
+/// The options the warp tests use: cavity label 250 (no label of the case).
+inline WarpOptions warp_test_options() {
+  WarpOptions o;
+  o.cavity_label = 250;
+  return o;
+}
+
+/// A 24×24×20 grid with anisotropic spacing and an oblique direction, so index/world slips cannot cancel.
+inline Geometry oblique_test_grid() {
+  Geometry g;
+  g.dims = {24, 24, 20};
+  g.spacing_mm = Vec3(0.8, 0.8, 1.6);
+  g.direction = Eigen::AngleAxisd(0.3, Vec3(1, 1, 0).normalized()).toRotationMatrix();
+  g.origin_mm = Vec3(-20, 35, -110);
+  return g;
+}
+
+/// A smooth, seeded deformation of the case's mesh with per-node jitter (±0.35 voxel): the wall
+/// lifts by about 2.5 voxels and the viscera sink; `toward` > 0 presses them into each other (their
+/// tetrahedra then overlap, so "the lowest accepting index wins" decides). `reversed` numbers the
+/// tetrahedra last cube first, so owners, not visiting order, must decide.
+inline WarpMesh random_warp_mesh(const WarpCase& c, uint32_t seed, double toward, bool reversed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(-0.35, 0.35);
+  std::vector<Vec3> u(std::size_t(c.mesh.node_count()));
+  for (int64_t n = 0; n < c.mesh.node_count(); ++n) {
+    const Vec3 x = c.grid.to_index(1e3 * c.mesh.rest_m[n]);
+    const Vec3 smooth = c.mesh.node_part[n] == Part::Wall
+                            ? Vec3(0.4 * std::cos(x[2] / 3.0), 2.5 + std::sin(x[0] / 5.0) - 2.5 * toward, 0)
+                            : Vec3(0, -0.8 + toward, 0.5 * std::sin(x[1] / 4.0));
+    u[std::size_t(n)] = 1e-3 * (c.index_to_mm() * (smooth + Vec3(jitter(rng), jitter(rng), jitter(rng))));
+  }
+  WarpMesh m = make_warp_mesh(c.mesh, u);
+  if (reversed) {
+    std::reverse(m.tets.begin(), m.tets.end());
+    std::reverse(m.tet_part.begin(), m.tet_part.end());
+  }
+  return m;
+}
+
+/// Two warps of the same mesh and box compared voxel by voxel: where both carry a voxel, the worst
+/// CT difference; elsewhere equal outcomes must give equal CT (gas or the voxel's own value, no
+/// arithmetic; checked here); every voxel whose outcome or label differs is a measured tie or not.
+struct WarpComparison {
+  int64_t both_carried = 0, ties = 0, untied = 0;
+  double worst_hu = 0.0;
+};
+inline WarpComparison compare_warps(const WarpResult& a, const WarpResult& b, const WarpMesh& m, const WarpBox& box) {
+  WarpComparison out;
+  EXPECT_EQ(a.ct_hu.size(), b.ct_hu.size());
+  if (a.ct_hu.size() != b.ct_hu.size()) return out;
+  for (int64_t k = 0; k < box.dims[2]; ++k)
+    for (int64_t j = 0; j < box.dims[1]; ++j)
+      for (int64_t i = 0; i < box.dims[0]; ++i) {
+        const std::size_t n = std::size_t(i + box.dims[0] * (j + box.dims[1] * k));
+        if (a.outcome[n] == WarpOutcome::Carried && b.outcome[n] == WarpOutcome::Carried) {
+          ++out.both_carried;
+          out.worst_hu = std::max(out.worst_hu, std::abs(double(a.ct_hu[n]) - double(b.ct_hu[n])));
+        } else if (a.outcome[n] == b.outcome[n]) {
+          EXPECT_EQ(a.ct_hu[n], b.ct_hu[n]);
+        }
+        if (a.outcome[n] == b.outcome[n] && a.labels[n] == b.labels[n]) continue;
+        ++(measured_tie(m, Vec3(double(i + box.lo[0]), double(j + box.lo[1]), double(k + box.lo[2]))) ? out.ties
+                                                                                                      : out.untied);
+      }
+  return out;
+}
+
 }  // namespace pneumo::testing_support
