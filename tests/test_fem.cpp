@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "core/error.h"
 #include "core/progress.h"
 #include "mesh/mesh.h"
 #include "solve/fem_element.h"
@@ -410,6 +411,31 @@ TEST(StaticSolvers, FireAndNewtonReachTheSameEquilibriumForEveryField) {
                 1e3 * d.moved, d.worst);
     EXPECT_GT(d.moved, 1e-5);
     EXPECT_LT(d.worst, 1e-8);
+  }
+}
+
+TEST(StaticSolvers, SchemesBuiltOnTheSpringsRefuseTheFiniteElements) {
+  // The explicit, Newmark and 2004 schemes take their step, dampers or stiffness sums from the
+  // springs: asked to solve finite elements they must refuse (InputError naming the model), not
+  // quietly solve the springs or run an unstable step. The springs themselves still solve.
+  Progress::set_enabled(false);
+  const Mesh m = block_mesh(3, 2);
+  for (SolverMethod method : {SolverMethod::Explicit, SolverMethod::Newmark, SolverMethod::Kitasaka2004}) {
+    SCOPED_TRACE(enum_name(method));
+    SolveOptions o;
+    o.method = method;
+    o.max_steps = 20;
+    o.progress = false;
+    o.forces.pressure_pa = 1333.2;
+    o.forces.material = MaterialModel::FemCorotational;
+    try {
+      solve(m, o);
+      ADD_FAILURE() << "solved finite elements";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("fem-corotational"), std::string::npos) << e.what();
+    }
+    o.forces.material = MaterialModel::Msd;
+    EXPECT_NO_THROW(solve(m, o));
   }
 }
 

@@ -21,7 +21,8 @@ enum class RampShape : uint8_t { Smooth, Linear };
 enum class SolverMethod : uint8_t { Static, Explicit, Newmark, Kitasaka2004, Newton, ImplicitEuler };
 enum class OnInverted : uint8_t { Continue, Stop };
 /// The solvers that take any force field (solve/force_field.h), which the finite elements and contact
-/// need; the explicit schemes and the 2004 scheme call the springs' evaluator directly.
+/// need; the explicit, Newmark and 2004 schemes rely on the springs' own stable step, dampers and
+/// stiffness sums.
 inline bool solves_force_fields(SolverMethod m) {
   return m == SolverMethod::Static || m == SolverMethod::Newton || m == SolverMethod::ImplicitEuler;
 }

@@ -58,8 +58,8 @@ void check_label_young(const SceneMaterial& m, const At& material) {
 // the co-rotational law has no stiffening.
 void check_material_model(const Scene& s, const At& root) {
   const SceneMaterial& m = s.material;
-  // The contact term lives in the force fields (solve/contact.h); the explicit schemes and the 2004
-  // scheme call the springs' evaluator directly.
+  // The contact term wraps a force field (solve/contact.h); the explicit, Newmark and 2004 schemes
+  // rely on the springs' own step, dampers and stiffness sums (solver.cpp refuses it too).
   if (m.contact && !solves_force_fields(s.solver.method))
     root.child("solver").child("method").fail_value(enum_name(s.solver.method),
                                                     "cannot solve with material.contact; use \"newton\", \"static\" "

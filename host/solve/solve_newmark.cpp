@@ -4,6 +4,7 @@
 // converges only when ωΔt < 2(√(1+ξ²) − ξ) for every mode, no more stable than explicit.
 #include <cmath>
 
+#include "solve/force_field.h"
 #include "solve/solver_common.h"
 
 namespace pneumo {
@@ -22,7 +23,7 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
   detail::Monitor mon(m, opt, "newmark", r);
   const double dt = detail::chosen_dt(m, opt, opt.forces.damping, r);
   const double beta = opt.newmark_beta, gamma = opt.newmark_gamma;
-  ForceEvaluator eval(m);
+  const std::unique_ptr<ForceField> field = make_force_field(m, opt.forces);   // the springs (solve() admits no other)
   const int64_t N = m.node_count();
   std::vector<Vec3> v(N, Vec3::Zero()), a(N, Vec3::Zero()), a_next(N), xp(N), vp(N), xt(N), vt(N), f;
   // The inner loop's change is measured against the accelerations, floored by the acceleration the
@@ -47,7 +48,7 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
         xt[n] = xp[n] + beta * dt * dt * a[n];
         vt[n] = vp[n] + gamma * dt * a[n];
       }
-      eval.evaluate(model, xt, vt, f);
+      field->evaluate(model, xt, vt, f);
       for (int64_t n = 0; n < N; ++n) a_next[n] = f[n] / m.mass_kg[n];
       detail::apply_holds(m, a_next);
       double change = 0.0;
@@ -70,7 +71,7 @@ SolveResult solve_newmark(const Mesh& m, const SolveOptions& opt, std::vector<Ve
     if (reason) break;
   }
   r.final_pressure_pa = model.pressure_pa;
-  mon.finish(x, v, step, eval.evaluations(), reason.value_or(StopReason::StepLimit), residual);
+  mon.finish(x, v, step, field->evaluations(), reason.value_or(StopReason::StepLimit), residual);
   return r;
 }
 

@@ -57,6 +57,11 @@ SolveResult solve(const Mesh& m, const SolveOptions& opt, const std::vector<Vec3
   if (opt.forces.contact_stiffness > 0.0 && !solves_force_fields(opt.method))
     throw InputError(std::string("contact needs solver.method \"static\", \"newton\" or \"implicit-euler\", not \"") +
                      enum_name(opt.method) + "\"");
+  // The explicit and Newmark schemes take their stable step and damping from the springs, the 2004
+  // scheme their stiffness sums: the finite elements have neither (scene_validate.cpp refuses it too).
+  if (opt.forces.material != MaterialModel::Msd && !solves_force_fields(opt.method))
+    throw InputError(std::string("material model \"") + enum_name(opt.forces.material) + "\" needs solver.method "
+                     "\"static\", \"newton\" or \"implicit-euler\", not \"" + enum_name(opt.method) + "\"");
   switch (opt.method) {
     case SolverMethod::Explicit: return solve_explicit(m, opt, std::move(x));
     case SolverMethod::Newmark: return solve_newmark(m, opt, std::move(x));
