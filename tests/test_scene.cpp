@@ -262,7 +262,14 @@ TEST(SceneErrors, OutOfRangeSamples) {
       {{{"load", {{"pressure_mmhg", 150}}}}, "load.pressure_mmhg", "150", "allowed: 0 to 100 mmHg"},
       {{{"mesh", {{"cube_voxels", 0}}}}, "mesh.cube_voxels", "0", "allowed: 1 to 64"},
       {{{"material", {{"damping_ratio", -1}}}}, "material.damping_ratio", "-1", "allowed: 0 to 10"},
-      {{{"material", {{"young_kpa", 0}}}}, "material.young_kpa", "0", "allowed: > 0 and <= 1000000 kPa"},
+      {{{"material", {{"young_kpa", 0}}}}, "material.young_kpa", "0", "allowed: 0.1 to 1000000 kPa"},
+      // Values that parse yet make the forces vanish against rounding (NaN, or no end): refused at
+      // the physical floors (issue "Nothing lost, nothing silently wrong").
+      {{{"material", {{"young_kpa", 1e-100}}}}, "material.young_kpa", "1e-100", "allowed: 0.1 to 1000000 kPa"},
+      {{{"material", {{"wall_young_kpa", 1e-300}}}}, "material.wall_young_kpa", "1e-300", "allowed: 0.1 to 1000000 kPa"},
+      {{{"material", {{"label_young_kpa", {{{"label", 3}, {"young_kpa", 1e-300}}}}}}},
+       "material.label_young_kpa[0].young_kpa", "1e-300", "allowed: 0.1 to 1000000 kPa"},
+      {{{"material", {{"spring_scale", 1e-300}}}}, "material.spring_scale", "1e-300", "allowed: 0.01 to 10"},
       {{{"solver", {{"dt_safety", 0}}}}, "solver.dt_safety", "0", "allowed: > 0 and <= 1"},
       {{{"render", {{"step_fraction", 0.6}}}}, "render.step_fraction", "0.6", "allowed: > 0 and <= 0.5"},
       {{{"roles", {{"wall_labels", {1, 70000}}}}}, "roles.wall_labels[1]", "70000", "allowed: 0 to 65535"},
@@ -300,6 +307,14 @@ TEST(SceneErrors, EveryBoundIsEnforced) {
 TEST(SceneErrors, RulesBeyondRanges) {
   EXPECT_CONTAINS(error_of({{"load", {{"pressure_curve_mmhg", {5, 10, 8}}}}}),
                   "load.pressure_curve_mmhg = [5,10,8] is not allowed; non-decreasing");
+  // A positive pressure too small to move the wall past rounding: refused; 0 (rest) is allowed.
+  EXPECT_CONTAINS(error_of({{"load", {{"pressure_mmhg", 1e-9}}}}),
+                  "load.pressure_mmhg = 1e-09 is not allowed; 0 (rest) or at least 0.1");
+  EXPECT_EQ(error_of({{"load", {{"pressure_mmhg", 0}}}}), "");
+  EXPECT_EQ(error_of({{"load", {{"pressure_mmhg", 0.1}}}}), "");
+  EXPECT_CONTAINS(error_of({{"load", {{"pressure_curve_mmhg", {0, 0.01, 5}}}}}),
+                  "is not allowed; non-decreasing, each 0 (rest) or at least 0.1");
+  EXPECT_EQ(error_of({{"load", {{"pressure_curve_mmhg", {0, 0.5, 5}}}}}), "");
   EXPECT_CONTAINS(error_of({{"device", "gpu"}}), "device = \"gpu\" is not allowed; \"cpu\", \"opencl\", \"opencl:P:D\"");
   EXPECT_NE(error_of({{"device", "opencl:0"}}), "");
   EXPECT_NE(error_of({{"device", "opencl:a:1"}}), "");
@@ -569,7 +584,7 @@ TEST(SceneReference, ListsEveryKey) {
   for (const char* heading : {"## Top level", "## `load`", "## `render.cameras[]` (each item)",
                               "## `render.paths[].keyframes[]` (each item)", "## `material.label_young_kpa[]` (each item)"})
     EXPECT_CONTAINS(md, heading);
-  for (const char* row : {"| `pressure_mmhg` | number | `12.0` | 0 to 100 | mmHg |", "| `fov_deg` | number | `70.0` |",
+  for (const char* row : {"| `pressure_mmhg` | number | `12.0` | 0 to 100; 0 (rest) or at least 0.1 | mmHg |", "| `fov_deg` | number | `70.0` |",
                           "| `method` | enum | `\"static\"` | \"static\", \"explicit\", \"newmark\", \"kitasaka2004\", \"newton\", "
                           "\"implicit-euler\" |"})
     EXPECT_CONTAINS(md, row);

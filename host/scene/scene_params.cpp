@@ -64,6 +64,20 @@ bool is_colour_points(const json& v) { return is_points(v, 4); }
 
 constexpr double kMaxLabel = 65535;  // label maps are read as up to 16-bit ids
 constexpr double kMaxKPa = 1e6;      // 1 GPa: above any soft tissue by far, below overflow worries
+// 0.1 kPa: ten times softer than the softest tissue of an abdomen (fat, 1-3 kPa; docs/fidelity.md).
+// Below it a value only makes the forces vanish against rounding: NaN or a solve without end.
+constexpr double kMinKPa = 0.1;
+// 0.1 mmHg: a tenth of the lowest pressure an insufflator sets. A positive pressure below it moves
+// the wall by less than rounding can tell from rest, so the solve cannot see it converge; 0 is the rest state.
+constexpr double kMinPressureMmHg = 0.1;
+bool is_rest_or_real_pressure(double p) { return p == 0.0 || p >= kMinPressureMmHg; }
+bool rest_or_real_pressure(const json& v) { return is_rest_or_real_pressure(v.get<double>()); }
+bool is_pressure_curve(const json& v) {
+  if (!is_non_decreasing(v)) return false;
+  for (const json& p : v)
+    if (!is_rest_or_real_pressure(p.get<double>())) return false;
+  return true;
+}
 
 // ---- sections ----------------------------------------------------------------------------------
 
@@ -136,7 +150,7 @@ const Table<SceneMesh>& mesh_table() {
 const Table<LabelYoung>& label_young_table() {
   static const Table<LabelYoung> t{
       {"label", &LabelYoung::label, "", in(0, kMaxLabel).req(), "Label id."},
-      {"young_kpa", &LabelYoung::young_kpa, "kPa", above(0, kMaxKPa).req(), "Young's modulus of tetrahedra of this label."},
+      {"young_kpa", &LabelYoung::young_kpa, "kPa", in(kMinKPa, kMaxKPa).req(), "Young's modulus of tetrahedra of this label."},
       {"poisson_ratio", &LabelYoung::poisson_ratio, "", in(0, 0.49),
        "ν of this label's finite elements; unset = its role's (the springs ignore it)."},
   };
@@ -147,22 +161,22 @@ const Table<SceneMaterial>& material_table() {
   static const Table<SceneMaterial> t{
       {"density_kg_m3", &SceneMaterial::density_kg_m3, "kg/m³", in(100, 5000),
        "ρ: node mass = ρ × a quarter of each adjacent tetrahedron's volume (§4; Nimura 1096)."},
-      {"young_kpa", &SceneMaterial::young_kpa, "kPa", above(0, kMaxKPa),
+      {"young_kpa", &SceneMaterial::young_kpa, "kPa", in(kMinKPa, kMaxKPa),
        "E of every tetrahedron unless overridden (§4; Nimura 60; measured wall 22.5-42.5)."},
-      {"wall_young_kpa", &SceneMaterial::wall_young_kpa, "kPa", above(0, kMaxKPa),
+      {"wall_young_kpa", &SceneMaterial::wall_young_kpa, "kPa", in(kMinKPa, kMaxKPa),
        "E of wall tetrahedra; unset = young_kpa (Bano: 24)."},
-      {"viscera_young_kpa", &SceneMaterial::viscera_young_kpa, "kPa", above(0, kMaxKPa),
+      {"viscera_young_kpa", &SceneMaterial::viscera_young_kpa, "kPa", in(kMinKPa, kMaxKPa),
        "E of viscera tetrahedra; unset = young_kpa (Bano: 15)."},
       {"label_young_kpa", &SceneMaterial::label_young_kpa, label_young_table(), any(),
        "E per label id, over the role's value: [{\"label\": 5, \"young_kpa\": 3}]."},
-      {"fat_young_kpa", &SceneMaterial::fat_young_kpa, "kPa", above(0, kMaxKPa),
+      {"fat_young_kpa", &SceneMaterial::fat_young_kpa, "kPa", in(kMinKPa, kMaxKPa),
        "E of wall and viscera voxels in the fat window [fat_hu_min, fat_hu_max] unless their label has one; "
        "unset = off (their role's E). Fat is far softer than muscle: 1-3 kPa (docs/fidelity.md)."},
       {"fat_hu_min", &SceneMaterial::fat_hu_min, "HU", in(-1024, 3071), "Lower end of the fat window (-190)."},
       {"fat_hu_max", &SceneMaterial::fat_hu_max, "HU", in(-1024, 3071), "Upper end of the fat window (-30)."},
       {"damping_ratio", &SceneMaterial::damping_ratio, "", in(0, 10),
        "ζ: each spring's damper c = 2ζ√(m k) (§4; Nimura 0.4)."},
-      {"spring_scale", &SceneMaterial::spring_scale, "", above(0, 10),
+      {"spring_scale", &SceneMaterial::spring_scale, "", in(0.01, 10),
        "Multiplies every spring stiffness; 0.925 makes the lattice's isotropic modulus equal E (§4)."},
       {"spring_model", &SceneMaterial::spring_model, "", any(),
        "\"nonlinear\": rotation-invariant springs (§5); \"linear\": Nimura's Eq. 1 as printed."},
@@ -208,7 +222,8 @@ const Table<SceneMaterial>& material_table() {
 
 const Table<SceneLoad>& load_table() {
   static const Table<SceneLoad> t{
-      {"pressure_mmhg", &SceneLoad::pressure_mmhg, "mmHg", in(0, 100),
+      {"pressure_mmhg", &SceneLoad::pressure_mmhg, "mmHg",
+       in(0, 100).rule("0 (rest) or at least 0.1", rest_or_real_pressure),
        "CO2 pressure on the cavity surfaces (§5). 12 is usual in surgery (Nimura used 10)."},
       {"ramp_ms", &SceneLoad::ramp_ms, "ms", in(0, 600000),
        "Time to ramp the pressure up (§6); 0 = all at once (overshoots). 500 ≈ 2.5 periods of an adult "
@@ -216,7 +231,7 @@ const Table<SceneLoad>& load_table() {
       {"ramp_shape", &SceneLoad::ramp_shape, "", any(),
        "\"smooth\": (1 - cos πτ)/2; \"linear\": τ (§6)."},
       {"pressure_curve_mmhg", &SceneLoad::pressure_curve_mmhg, "mmHg",
-       in(0, 100).items(0, 100).rule("non-decreasing", is_non_decreasing),
+       in(0, 100).items(0, 100).rule("non-decreasing, each 0 (rest) or at least 0.1", is_pressure_curve),
        "Pressures for a pressure-volume curve, each run to equilibrium from the previous one (§9). "
        "Empty: pressure_mmhg only."},
   };
