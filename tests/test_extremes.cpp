@@ -264,6 +264,38 @@ TEST(ExtremeLoad, PressuresFrom0To60MmHg) {
   }
 }
 
+TEST(ExtremeMaterial, ANonFiniteStiffnessStopsEverySolverAndNothingIsCalledConverged) {
+  // One spring's stiffness and one tetrahedron's modulus NaN (what an underflowing or overflowing
+  // material gives): the forces turn NaN at a node. Every scheme must stop with a DivergedError that
+  // says "non-finite", never return a result (converged or not) holding NaN. A running maximum of
+  // the residual or the displacement built on std::max passes over NaN; this is what catches it.
+  const OneThread one;
+  Mesh m = slab();
+  // A spring and a tetrahedron whose nodes are all free: at a held node the solvers zero the force.
+  std::size_t spring = 0, tet = 0;
+  while (m.hold[m.springs[spring][0]] != 0 || m.hold[m.springs[spring][1]] != 0) ++spring;
+  auto free_tet = [&](std::size_t t) {
+    for (int32_t n : m.tets[t])
+      if (m.hold[n] != 0) return false;
+    return true;
+  };
+  while (!free_tet(tet)) ++tet;
+  m.spring_k[spring] = std::nan("");
+  m.tet_young_pa[tet] = std::nan("");
+  for (SolverMethod method : {SolverMethod::Static, SolverMethod::Newton, SolverMethod::Explicit, SolverMethod::Newmark,
+                              SolverMethod::Kitasaka2004, SolverMethod::ImplicitEuler}) {
+    SCOPED_TRACE(enum_name(method));
+    SolveOptions o = quiet(method, 12.0);
+    o.max_steps = 2000;
+    try {
+      const SolveResult r = solve(m, o);
+      ADD_FAILURE() << "returned " << r.stop_reason << (all_finite(r.x) ? " with finite positions" : " with NaN");
+    } catch (const DivergedError& e) {
+      EXPECT_NE(std::string(e.what()).find("non-finite"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(ExtremeDamping, ZetaZeroNeverSettlesZetaTwoDoes) {
   // Compared: the explicit solver (automatic Δt, 10 mmHg ramped over 20 ms) at damping ratios 0 and 2:
   //  - ζ = 0: nothing removes energy, the slab oscillates for ever: the run must end at its step limit,

@@ -58,6 +58,7 @@ SolveResult solve_newton_on(const Mesh& m, const SolveOptions& opt, ForceField& 
     field.evaluate(model, x, {}, f);
     detail::apply_holds(m, f);
     residual = mon.residual(f);
+    mon.check_finite_forces(residual, step);
     double norm = std::sqrt(dot(f, f)), previous_norm = NAN;
     int64_t inverted = count_inverted(m, x);
     bool increment_done = residual < tol;

@@ -107,23 +107,37 @@ Monitor::Monitor(const Mesh& m, const SolveOptions& opt, const std::string& solv
   extent_m_ = std::max((hi - lo).norm(), 1e-3);
 }
 
+// The three maxima below are infinite as soon as one term is not finite: std::max(m, NaN) keeps m,
+// so a plain running maximum would pass over a NaN force or position and call the run converged.
 double Monitor::residual(const std::vector<Vec3>& f) const {
   double worst = 0.0;
   for (int64_t n = 0; n < m_.node_count(); ++n)
     for (int a = 0; a < 3; ++a)
-      if (!(m_.hold[n] & (1 << a))) worst = std::max(worst, std::abs(f[n][a]));
+      if (!(m_.hold[n] & (1 << a))) {
+        const double c = std::abs(f[n][a]);
+        if (!std::isfinite(c)) return INFINITY;
+        worst = std::max(worst, c);
+      }
   return worst / ref_load_;
 }
 
 double Monitor::max_speed(const std::vector<Vec3>& v) const {
   double s = 0.0;
-  for (const auto& x : v) s = std::max(s, x.norm());
+  for (const auto& x : v) {
+    const double c = x.norm();
+    if (!std::isfinite(c)) return INFINITY;
+    s = std::max(s, c);
+  }
   return s;
 }
 
 double Monitor::max_displacement(const std::vector<Vec3>& x) const {
   double d = 0.0;
-  for (int64_t n = 0; n < m_.node_count(); ++n) d = std::max(d, (x[n] - m_.rest_m[n]).norm());
+  for (int64_t n = 0; n < m_.node_count(); ++n) {
+    const double c = (x[n] - m_.rest_m[n]).norm();
+    if (!std::isfinite(c)) return INFINITY;
+    d = std::max(d, c);
+  }
   return d;
 }
 
@@ -153,8 +167,20 @@ bool Monitor::record(int64_t step, double time_s, double pressure_pa, double res
                 [&]() -> const std::vector<Vec3>& { return x; });
 }
 
+void Monitor::check_finite_forces(double residual, int64_t step) const {
+  // A NaN or infinite force (residual() makes any non-finite term infinite) ends every scheme,
+  // whether or not it has reached the positions yet: a line search would only call it "no descent".
+  if (std::isfinite(residual)) return;
+  std::ostringstream os;
+  os << r_.solver << " diverged at step " << step
+     << " (non-finite forces): a material value that makes them overflow or vanish (material.young_kpa and its "
+        "overrides, spring_scale, density_kg_m3) or the load; check them";
+  throw DivergedError(os.str(), r_.dt_stable_s);
+}
+
 bool Monitor::record(int64_t step, double time_s, double pressure_pa, double residual, double max_displacement_m,
                      double max_speed_m_s, const std::function<const std::vector<Vec3>&()>& positions) {
+  check_finite_forces(residual, step);
   SolveSample s;
   s.step = step;
   s.time_s = time_s;
@@ -214,6 +240,8 @@ std::optional<StopReason> Monitor::check_dynamic(int64_t step, double time_s, do
 
 void Monitor::finish(const std::vector<Vec3>& x, const std::vector<Vec3>& v, int64_t steps, int64_t force_evaluations,
                      StopReason stop_reason, double residual) {
+  // Whatever the scheme checked on the way, no result with a non-finite position leaves a solver.
+  check_diverged(max_displacement(x), steps, std::string(kLoadAdvice));
   r_.x = x;
   r_.v = v.empty() ? std::vector<Vec3>(x.size(), Vec3::Zero()) : v;
   r_.steps = steps;

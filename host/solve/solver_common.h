@@ -129,6 +129,8 @@ class Monitor {
   void check_diverged(const std::vector<Vec3>& x, int64_t step, const std::string& parameter_advice) const;
   /// The same from the largest displacement (NaN or infinite for non-finite positions).
   void check_diverged(double max_displacement_m, int64_t step, const std::string& parameter_advice) const;
+  /// Throws DivergedError (naming the material keys) when `residual` is not finite; record() calls it.
+  void check_finite_forces(double residual, int64_t step) const;
   /// Records a history row, shows progress; returns true when the run must stop for inversion.
   bool record(int64_t step, double time_s, double pressure_pa, double residual, const std::vector<Vec3>& x,
               const std::vector<Vec3>& v);
