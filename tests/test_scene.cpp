@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -551,6 +552,31 @@ TEST(SceneFiles, MissingFileDuplicateKeysAndComments) {
   }
   const std::string commented = write_temp("comments.json", "{\n  // clinical pressure\n  \"load\": {\"pressure_mmhg\": 14} /* mmHg */\n}\n");
   EXPECT_EQ(load_scene(commented).load.pressure_mmhg, 14.0);
+}
+
+TEST(SceneFiles, DeepNestingAndHugeFilesAreRefusedBeforeParsing) {
+  // 200,000 nested "[" (400 kB) once kept the parser busy for minutes with memory growing
+  // quadratically: refused at once, naming the limit and where it was crossed. Brackets inside
+  // strings and comments do not count, and a scene at the limit still reads as JSON.
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string deep = write_temp("deep.json", std::string(200000, '[') + std::string(200000, ']'));
+  try {
+    load_scene(deep);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_CONTAINS(e.what(), "deep.json: nests arrays and objects deeper than 64 levels (at line 1, column 65)");
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  const std::string quoted = write_temp("quoted.json", "{\"name\": \"" + std::string(100, '[') + "\" /* " +
+                                                           std::string(100, '{') + " */}\n// " + std::string(100, '[') + "\n");
+  EXPECT_EQ(load_scene(quoted).name, std::string(100, '['));
+  const std::string big = write_temp("big.json", "{\"name\": \"" + std::string(17u << 20, 'x') + "\"}");
+  try {
+    load_scene(big);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_CONTAINS(e.what(), "big.json: is 17 MB; a scene file is at most 16 MB");
+  }
 }
 
 TEST(SceneFiles, EverySceneInTheRepoLoads) {

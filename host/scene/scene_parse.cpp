@@ -1,5 +1,6 @@
 // Scene files → Scene: reading the text (JSON with comments, duplicate keys refused, errors with
 // line and column), then the parameter table, then the cross-key rules.
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -99,13 +100,50 @@ std::string parse_problem(const json::exception& e) {
   return what;
 }
 
+// Bounded work for bounded input. A scene is a few kB and nests at most seven levels (the scene,
+// render, paths, a path, its keyframes, a keyframe, a 3-vector); the limits leave room for
+// hand-written ones many times larger, and stop a hostile one (200,000 nested "[") before the
+// parser spends minutes and gigabytes on it.
+constexpr std::uintmax_t kMaxSceneBytes = 16u << 20;
+constexpr int kMaxSceneNesting = 64;
+
+/// The deepest nesting of [ and { outside strings and comments (what the parser would build).
+void check_nesting(const std::string& text, const std::string& path) {
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+      continue;
+    }
+    if (c == '"') in_string = true;
+    else if (c == '/' && i + 1 < text.size() && text[i + 1] == '/') i = std::min(text.find('\n', i), text.size());
+    else if (c == '/' && i + 1 < text.size() && text[i + 1] == '*') {
+      const std::size_t end = text.find("*/", i + 2);
+      i = end == std::string::npos ? text.size() : end + 1;   // an open comment: the parser reports it
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxSceneNesting)
+        throw file_error(path, "nests arrays and objects deeper than " + std::to_string(kMaxSceneNesting) +
+                                   " levels (at " + line_column(text, i) + "); a scene needs fewer than ten");
+    } else if (c == ']' || c == '}') --depth;
+  }
+}
+
 json read_json_file(const std::string& path) {
   if (std::filesystem::is_directory(path)) throw file_error(path, "is a folder, not a scene file");
+  std::error_code size_error;
+  const std::uintmax_t bytes = std::filesystem::file_size(path, size_error);
+  if (!size_error && bytes > kMaxSceneBytes)
+    throw file_error(path, "is " + std::to_string(bytes >> 20) + " MB; a scene file is at most " +
+                               std::to_string(kMaxSceneBytes >> 20) + " MB (scenes are a few kB)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw file_error(path, std::string("cannot open the scene file (") + std::strerror(errno) + ")");
   std::ostringstream buffer;
   buffer << in.rdbuf();
   const std::string text = buffer.str();
+  check_nesting(text, path);
   try {
     // Comments (// and /* */) are allowed: scenes are written by hand.
     return json::parse(text, DuplicateKeyCheck(path), /*allow_exceptions=*/true, /*ignore_comments=*/true);
