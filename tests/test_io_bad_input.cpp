@@ -147,6 +147,9 @@ std::vector<BadInput> bad_inputs() {
        "truncated"},
       {"meta_absurd_dims",
        [](D d) { return meta_file(d, "a.mha", MetaText().set("DimSize", "100000 100000 100000")); }, "absurd"},
+      // 2 bytes × 2^32 × 2^32 × 16 is 0 in 64 bits: once read as "0 voxels", then a crash in the padding.
+      {"meta_overflowing_dims",
+       [](D d) { return meta_file(d, "a.mha", MetaText().set("DimSize", "4294967296 4294967296 16")); }, "absurd"},
       {"meta_zero_dim", [](D d) { return meta_file(d, "a.mha", MetaText().set("DimSize", "10 0 10")); },
        "must be at least 1"},
       {"meta_zero_spacing", [](D d) { return meta_file(d, "a.mha", MetaText().set("ElementSpacing", "1 0 1")); },

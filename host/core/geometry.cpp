@@ -76,10 +76,15 @@ bool Geometry::same_grid(const Geometry& o, double tol_mm) const {
 }
 
 void Geometry::validate(const std::string& what) const {
+  // Bounds that keep every size computed from the dimensions (voxels, bytes, padded and working
+  // grids) far inside int64: a header promising 2^32 × 2^32 × 16 voxels multiplies to 0 in 64 bits
+  // and would pass every later check. 2^20 voxels an axis and 2^36 in all are 100 times a
+  // 0.25 mm whole-body CT (2000 × 2000 × 8000 = 3.2·10^10 is the largest imaginable).
+  constexpr int64_t kMaxAxis = int64_t(1) << 20, kMaxVoxels = int64_t(1) << 36;
   for (int a = 0; a < 3; ++a) {
-    if (dims[a] < 1) {
+    if (dims[a] < 1 || dims[a] > kMaxAxis) {
       std::ostringstream os;
-      os << "dimension " << a << " is " << dims[a] << " (must be at least 1)";
+      os << "dimension " << a << " is " << dims[a] << " (must be 1 to " << kMaxAxis << ")";
       throw file_error(what, os.str());
     }
     if (!std::isfinite(spacing_mm[a]) || !(spacing_mm[a] > 0.0)) {
@@ -87,6 +92,12 @@ void Geometry::validate(const std::string& what) const {
       os << "spacing along axis " << a << " is " << spacing_mm[a] << " mm (must be finite and > 0)";
       throw file_error(what, os.str());
     }
+  }
+  if (dims[0] * dims[1] > kMaxVoxels / dims[2]) {   // each factor <= 2^20: the first product cannot overflow
+    std::ostringstream os;
+    os << dims[0] << " x " << dims[1] << " x " << dims[2] << " voxels is more than " << kMaxVoxels
+       << " (2^36), far beyond any CT: refusing an absurd header";
+    throw file_error(what, os.str());
   }
   if (!origin_mm.allFinite()) throw file_error(what, "the origin is not finite");
   if (!direction.allFinite()) throw file_error(what, "the direction matrix is not finite");

@@ -50,7 +50,8 @@ uint64_t checked_payload_bytes(const std::string& path, const int64_t dims[3], s
       os << "dimension " << a << " is " << dims[a] << " (must be at least 1)";
       throw file_error(path, os.str());
     }
-    if (static_cast<uint64_t>(dims[a]) > kMaxVolumeBytes || total * static_cast<uint64_t>(dims[a]) > kMaxVolumeBytes) {
+    // Divided, not multiplied: 2^33 bytes × 2^32 voxels is 0 in 64 bits and would pass.
+    if (static_cast<uint64_t>(dims[a]) > kMaxVolumeBytes / total) {
       std::ostringstream os;
       os << "dimensions " << dims[0] << " x " << dims[1] << " x " << dims[2] << " promise more than "
          << (kMaxVolumeBytes >> 30) << " GiB of voxels: refusing an absurd header";
