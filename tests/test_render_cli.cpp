@@ -65,6 +65,21 @@ TEST(RenderCli, WritesEveryViewKindWithEachBackend) {
   }
 }
 
+TEST(RenderCli, AFinishedRenderIsReplacedOnlyWithForce) {
+  // A second render into a folder that holds one (another width here) must refuse with exit 2 and
+  // leave the first views as they were; with --force it replaces them.
+  ScratchDir dir;
+  write_case(dir, all_kinds());
+  const std::string base = "render " + dir.file("scene.json") + " --out " + dir.file("out") + " --cpu";
+  ASSERT_EQ(run_pneumo(base).code, 0);
+  const auto before = fs::last_write_time(dir.path() / "out" / "render.json");
+  const auto again = run_pneumo(base);
+  EXPECT_EQ(again.code, 2) << again.err;
+  EXPECT_NE(again.err.find("already holds rendered views (render.json); use --force"), std::string::npos) << again.err;
+  EXPECT_EQ(fs::last_write_time(dir.path() / "out" / "render.json"), before);
+  EXPECT_EQ(run_pneumo(base + " --force").code, 0);
+}
+
 TEST(RenderCli, BadInputExitsTwoWithOneLine) {
   struct Bad { nlohmann::json render; const char* says; };
   nlohmann::json outside = all_kinds();

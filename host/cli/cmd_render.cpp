@@ -3,6 +3,7 @@
 
 #include "cli/commands.h"
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/warp_stage.h"
 
@@ -11,7 +12,7 @@ namespace pneumo::cli {
 Run add_render(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "render", "Render the laparoscope's views, ports, fly-throughs and exterior views of a scene into --out");
-  struct Opts { std::string scene, out, backend = "auto"; bool cpu = false; };
+  struct Opts { std::string scene, out, backend = "auto"; bool cpu = false, force = false; };
   auto o = std::make_shared<Opts>();
   cmd->add_option("scene", o->scene, "Scene .json")->required();
   cmd->add_option("--out", o->out,
@@ -19,8 +20,13 @@ Run add_render(CLI::App& app) {
       ->required();
   cmd->add_option("--backend", o->backend, "Offscreen OpenGL: auto, egl-device, egl-surfaceless or osmesa");
   cmd->add_flag("--cpu", o->cpu, "Render with the CPU reference ray caster instead of OpenGL (slow)");
+  cmd->add_flag("--force", o->force, "Replace the views of an earlier render in --out");
   return [=] {
     const Scene scene = load_scene(o->scene);
+    // A finished render (or run) in --out: its views are what its report shows; replacing them with
+    // other settings would leave a report of images it did not make. As simulate and warp refuse.
+    if (!o->force && std::filesystem::exists(std::filesystem::path(o->out) / "render.json"))
+      throw InputError(o->out + ": already holds rendered views (render.json); use --force to replace them");
     RenderOptions opt;
     opt.out_dir = o->out;
     opt.backend = parse_gl_backend(o->backend);
