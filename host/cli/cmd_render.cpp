@@ -4,6 +4,7 @@
 #include "cli/commands.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/output_lock.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/warp_stage.h"
 
@@ -23,6 +24,7 @@ Run add_render(CLI::App& app) {
   cmd->add_flag("--force", o->force, "Replace the views of an earlier render in --out");
   return [=] {
     const Scene scene = load_scene(o->scene);
+    const OutputFolderLock lock(o->out);   // one pneumo at a time in --out (core/output_lock.h)
     // A finished render (or run) in --out: its views are what its report shows; replacing them with
     // other settings would leave a report of images it did not make. As simulate and warp refuse.
     if (!o->force && std::filesystem::exists(std::filesystem::path(o->out) / "render.json"))

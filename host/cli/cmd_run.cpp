@@ -2,6 +2,7 @@
 
 #include "cl/cl_runtime.h"
 #include "cli/commands.h"
+#include "core/output_lock.h"
 #include "pipeline/run.h"
 
 namespace pneumo::cli {
@@ -29,6 +30,7 @@ Run add_run(CLI::App& app) {
     Scene scene = load_scene(o->scene);
     if (!o->device.empty()) scene.device = o->device;
     ocl::parse_device_spec(scene.device);   // a bad --device is bad input before any work
+    const OutputFolderLock lock(o->out);   // one pneumo at a time in --out (core/output_lock.h)
     RunOptions ro;
     ro.out_dir = o->out;
     ro.force = o->force;

@@ -5,6 +5,7 @@
 #include "cli/commands.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/output_lock.h"
 #include "pipeline/simulate.h"
 
 namespace pneumo::cli {
@@ -21,10 +22,11 @@ Run add_simulate(CLI::App& app) {
     Scene scene = load_scene(o->scene);
     if (!o->device.empty()) scene.device = o->device;
     ocl::parse_device_spec(scene.device);   // a bad --device is bad input before any work
+    const OutputFolderLock lock(o->out);   // one pneumo at a time in --out (core/output_lock.h)
     if (std::filesystem::exists(std::filesystem::path(o->out) / "metrics.json") && !o->force)
       throw InputError(o->out + ": already holds a simulation (metrics.json); use --force to overwrite");
-    // Checked now, created only once there are results: a run refused on the way (bad roles, a
-    // diverging solver) leaves nothing behind, not even an empty folder.
+    // The lock created --out if it was missing and removes it again if this run is refused on the
+    // way (bad roles, a diverging solver) before writing: nothing is left behind, not even a folder.
     check_creatable_folder(o->out);
     const Simulation sim = simulate_scene(scene);
     std::error_code ec;

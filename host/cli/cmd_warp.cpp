@@ -7,6 +7,7 @@
 #include "cli/commands.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/output_lock.h"
 #include "pipeline/warp_stage.h"
 
 namespace pneumo::cli {
@@ -34,6 +35,7 @@ Run add_warp(CLI::App& app) {
     Scene scene = load_scene(o->scene);
     if (!o->device.empty()) scene.device = o->device;
     ocl::parse_device_spec(scene.device);   // a bad --device is bad input before any work
+    const OutputFolderLock lock(o->out);   // one pneumo at a time in --out (core/output_lock.h)
     const std::string metrics_path = (std::filesystem::path(o->out) / "metrics.json").string();
     if (!o->force && (std::filesystem::exists(std::filesystem::path(o->out) / "deformed_ct.nii.gz") ||
                       warp_metrics_present(metrics_path)))

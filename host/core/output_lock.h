@@ -1,0 +1,27 @@
+#pragma once
+// One pneumo at a time per output folder. Two processes writing into one --out mixed their
+// results (a stale cavity volume reported, "metrics.json: not valid JSON"). The lock is flock(2) on
+// the folder itself: held for the life of the object, released by the kernel when the process ends
+// however it ends (kill -9 included), so no stale lock file is ever left to clean up.
+#include <string>
+#include <vector>
+
+namespace pneumo {
+
+class OutputFolderLock {
+ public:
+  /// Creates `dir` (and missing parents) when it does not exist, then locks it. InputError (exit 2)
+  /// when another process holds it, naming the folder, or when it cannot be created.
+  explicit OutputFolderLock(const std::string& dir);
+  /// Unlocks; removes the folders it created when they are still empty (a run refused on its input
+  /// leaves nothing behind).
+  ~OutputFolderLock();
+  OutputFolderLock(const OutputFolderLock&) = delete;
+  OutputFolderLock& operator=(const OutputFolderLock&) = delete;
+
+ private:
+  int fd_ = -1;
+  std::vector<std::string> created_;   // outermost first
+};
+
+}  // namespace pneumo

@@ -1,0 +1,75 @@
+// One pneumo at a time per output folder (core/output_lock.h): two runs into one --out once mixed
+// their results. Checked: a second lock on a held folder is refused naming it, and succeeds once
+// the first is gone; folders the lock created are removed again when nothing was written into
+// them; and every writing command refuses (exit 2, one line, the folder untouched) while another
+// process holds its --out.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "cli_test_support.h"
+#include "core/error.h"
+#include "core/output_lock.h"
+#include "io_test_support.h"
+#include "tiny_case_support.h"
+
+namespace pneumo {
+namespace {
+
+using testing_support::CliResult;
+using testing_support::run_pneumo;
+using testing_support::ScratchDir;
+using testing_support::tree;
+using testing_support::write_tiny_case;
+namespace fs = std::filesystem;
+
+TEST(OutputLock, ASecondLockIsRefusedUntilTheFirstIsGone) {
+  ScratchDir d;
+  const std::string out = d.file("out");
+  {
+    const OutputFolderLock first(out);
+    EXPECT_TRUE(fs::is_directory(out));
+    try {
+      const OutputFolderLock second(out);
+      ADD_FAILURE() << "two locks on one folder";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(out + ": another pneumo is writing into this folder"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_NO_THROW(OutputFolderLock again(out));
+}
+
+TEST(OutputLock, FoldersItCreatedGoWhenLeftEmptyAndStayWithResults) {
+  ScratchDir d;
+  { const OutputFolderLock lock(d.file("a/b/c")); }
+  EXPECT_FALSE(fs::exists(d.file("a"))) << "empty folders the lock made were left behind";
+  {
+    const OutputFolderLock lock(d.file("a/b/c"));
+    testing_support::write_bytes(d.file("a/b/c/metrics.json"), "{}\n");
+  }
+  EXPECT_TRUE(fs::exists(d.file("a/b/c/metrics.json")));
+  fs::create_directories(d.file("kept"));
+  { const OutputFolderLock lock(d.file("kept")); }
+  EXPECT_TRUE(fs::is_directory(d.file("kept"))) << "a folder the lock did not create was removed";
+}
+
+TEST(OutputLock, EveryWritingCommandRefusesAFolderAnotherProcessHolds) {
+  ScratchDir d;
+  const std::string scene = write_tiny_case(d);
+  ASSERT_EQ(run_pneumo("-q simulate " + scene + " --out " + d.file("sim")).code, 0);
+  const auto before = tree(d.path() / "sim");
+  // The lock is held by this process; the commands run as others, as a second user's would.
+  const OutputFolderLock held(d.file("sim"));
+  for (const char* command : {"simulate", "warp", "render", "run"}) {
+    SCOPED_TRACE(command);
+    const CliResult r = run_pneumo(std::string("-q ") + command + " " + scene + " --out " + d.file("sim") + " --force");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("another pneumo is writing into this folder"), std::string::npos) << r.err;
+    EXPECT_EQ(tree(d.path() / "sim"), before) << "the held folder changed";
+  }
+}
+
+}  // namespace
+}  // namespace pneumo
