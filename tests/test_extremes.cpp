@@ -23,6 +23,7 @@
 #include "solve/forces.h"
 #include "solve/solvable.h"
 #include "solve/solver.h"
+#include "solve/solver_common.h"
 #include "solve/solver_cl.h"
 
 #include "opencl_test_support.h"
@@ -319,6 +320,31 @@ TEST(ExtremeDamping, ZetaZeroNeverSettlesZetaTwoDoes) {
   EXPECT_TRUE(b.converged) << b.stop_reason;
   EXPECT_TRUE(all_finite(b.x));
   EXPECT_EQ(solve(undamped, quiet(SolverMethod::Static, 10.0)).x, solve(overdamped, quiet(SolverMethod::Static, 10.0)).x);
+}
+
+TEST(ExtremeDamping, AnUndampedSwingThatLeavesTheModelBlamesTheDamping) {
+  // ζ = 0: a dynamic scheme within its stable step overshoots the equilibrium by as much again and
+  // never settles; on the phantom at 12 mmHg the swing grows until the wall leaves the model (after
+  // 14,000 explicit steps, too slow for a test). The divergence it then reports must name
+  // material.damping_ratio, not the load or the time step; with dampers the load advice stays.
+  // Checked on the monitor that every scheme reports through, at the point a node has left the model.
+  for (const double zeta : {0.0, 0.4}) {
+    SCOPED_TRACE("zeta " + std::to_string(zeta));
+    const Mesh m = slab({1, 60e3, zeta});
+    const SolveOptions o = quiet(SolverMethod::Explicit, 12.0);
+    SolveResult r;
+    detail::Monitor mon(m, o, "explicit", r);
+    detail::chosen_dt(m, o, o.forces.damping, r);
+    try {
+      mon.check_diverged(1.0, 14000, "(the time-step advice)");   // 1 m: far beyond the 30 mm slab
+      ADD_FAILURE() << "no divergence reported";
+    } catch (const DivergedError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.find("material.damping_ratio") != std::string::npos, zeta == 0.0) << msg;
+      EXPECT_EQ(msg.find("load.pressure_mmhg") != std::string::npos, zeta > 0.0) << msg;
+      EXPECT_EQ(msg.find("time-step advice"), std::string::npos) << msg;
+    }
+  }
 }
 
 // ---- the mesh: cube size, one cube, nothing free, nothing holding the wall ------------------------------

@@ -150,6 +150,10 @@ void Monitor::check_diverged(double max_displacement_m, int64_t step, const std:
   if (max_displacement_m <= extent_m_) return;
   // A dynamic scheme within its stable step did not blow up by Δt: do not tell the user to shrink it.
   const bool dt_is_stable = r_.dt_s > 0.0 && r_.dt_s <= r_.dt_stable_s;
+  // Undamped, a dynamic scheme overshoots the equilibrium by as much again and never settles; with
+  // nonlinear springs the swing grows until the wall leaves the model: the damping is to blame.
+  const bool undamped = r_.dt_s > 0.0 && (!opt_.forces.damping || std::all_of(m_.spring_c.begin(), m_.spring_c.end(),
+                                                                               [](double c) { return c == 0.0; }));
   std::ostringstream os;
   os.precision(3);
   os << r_.solver << " diverged at step " << step << " (";
@@ -157,7 +161,13 @@ void Monitor::check_diverged(double max_displacement_m, int64_t step, const std:
     os << "a node moved " << units::m_to_mm(max_displacement_m) << " mm, beyond the model's size";
   else
     os << "non-finite positions";
-  os << "): " << (dt_is_stable ? std::string(kLoadAdvice) + " (the time step is within its stable estimate)" : advice);
+  os << "): ";
+  if (dt_is_stable && undamped)
+    os << "nothing damps the motion (material.damping_ratio is 0), so the wall's swing around its equilibrium grows "
+          "until it leaves the model; set material.damping_ratio above 0 (Nimura: 0.4) or use solver.method "
+          "\"static\", which needs no damping";
+  else
+    os << (dt_is_stable ? std::string(kLoadAdvice) + " (the time step is within its stable estimate)" : advice);
   throw DivergedError(os.str(), r_.dt_stable_s);
 }
 
