@@ -1,5 +1,6 @@
 #include "core/atomic_file.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -32,6 +33,15 @@ AtomicFile::~AtomicFile() {
 }
 
 void AtomicFile::commit() {
+  // On the disk before it takes the target's name: after a crash of the machine the name holds the
+  // old file or the whole new one, never a new name over blocks not yet written.
+  const int fd = ::open(temp_.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0 || ::fsync(fd) != 0) {
+    const int e = errno;
+    if (fd >= 0) ::close(fd);
+    throw std::runtime_error("cannot flush " + temp_ + " to disk: " + std::strerror(e));
+  }
+  ::close(fd);
   if (std::rename(temp_.c_str(), target_.c_str()) != 0)
     throw std::runtime_error("cannot rename " + temp_ + " to " + target_ + ": " + std::strerror(errno));
   committed_ = true;

@@ -1,7 +1,8 @@
 #pragma once
 // Writes that never leave a file looking complete when they were not: data goes to a temporary
-// name beside the target (same folder, so rename is atomic), and only commit() renames it into
-// place. If the writer throws or is interrupted, the destructor removes the temporary file.
+// name beside the target (same folder, so rename is atomic), and only commit() flushes it to disk
+// and renames it into place. If the writer throws or is interrupted, the destructor removes the
+// temporary file.
 #include <string>
 
 namespace pneumo {

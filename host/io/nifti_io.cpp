@@ -5,9 +5,11 @@
 #include <zlib.h>
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <mutex>
@@ -89,6 +91,60 @@ struct NimDeleter {
 using NimPtr = std::unique_ptr<nifti_image, NimDeleter>;
 
 bool is_gz(const std::string& path) { return volume_format_from_path(path) == VolumeFormat::NiftiGz; }
+
+/// Whether `path` is a whole gzip stream of `bytes` uncompressed bytes: the magic at its start and
+/// the ISIZE of its trailer (RFC 1952: the length mod 2^32, the last 4 bytes, little-endian).
+/// niftilib writes through gzwrite without checking it, so a full disk leaves a stream cut anywhere;
+/// its last four bytes then match by chance 1 time in 2^32.
+bool whole_gzip(const std::string& path, uint64_t bytes) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  unsigned char magic[2] = {0, 0}, tail[4] = {0, 0, 0, 0};
+  const bool read = std::fread(magic, 1, 2, f) == 2 && std::fseek(f, -4, SEEK_END) == 0 && std::fread(tail, 1, 4, f) == 4;
+  std::fclose(f);
+  const uint32_t isize = uint32_t(tail[0]) | uint32_t(tail[1]) << 8 | uint32_t(tail[2]) << 16 | uint32_t(tail[3]) << 24;
+  return read && magic[0] == 0x1f && magic[1] == 0x8b && isize == uint32_t(bytes);
+}
+
+/// Sends what niftilib prints on stderr to a temporary file for the life of the object, so that a
+/// failed write is reported once, by pneumo, naming the final file (niftilib names the temporary
+/// one). Writes are serialised: stderr is one per process.
+class CapturedStderr {
+ public:
+  CapturedStderr() : lock_(mutex()) {
+    std::fflush(stderr);
+    saved_ = ::dup(2);
+    file_ = std::tmpfile();
+    if (saved_ >= 0 && file_) ::dup2(::fileno(file_), 2);
+  }
+  ~CapturedStderr() { restore(); }
+  /// Restores stderr; returns what was printed meanwhile.
+  std::string restore() {
+    std::string text;
+    if (saved_ < 0) return text;
+    std::fflush(stderr);
+    ::dup2(saved_, 2);
+    ::close(saved_);
+    saved_ = -1;
+    if (file_) {
+      std::rewind(file_);
+      char buf[4096];
+      for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, file_)) > 0;) text.append(buf, n);
+      std::fclose(file_);
+      file_ = nullptr;
+    }
+    return text;
+  }
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  int saved_ = -1;
+  std::FILE* file_ = nullptr;
+};
 
 uint64_t file_size(const std::string& path) {
   struct stat st {};
@@ -326,11 +382,16 @@ void write_nifti(const Volume& v, const std::string& path) {
   nim->data = const_cast<void*>(v.raw());
   // zlib level 1: the fastest level (CT compresses little better at the default 6). Returns nothing useful:
   // check what it wrote.
+  CapturedStderr niftilib_messages;
   nifti_image_write_hdr_img(nim.get(), 1, "wb1");
+  const std::string printed = niftilib_messages.restore();
+  const uint64_t bytes = 352 + v.byte_count();   // header, extender, voxels
   struct stat st {};
-  const bool wrote = ::stat(out.temp_path().c_str(), &st) == 0 &&
-                     (is_gz(path) ? st.st_size > 0 : uint64_t(st.st_size) >= 352 + v.byte_count());
-  if (!wrote) throw std::runtime_error(path + ": writing failed (disk full or not writable?)");
+  const bool wrote = is_gz(path) ? whole_gzip(out.temp_path(), bytes)
+                                 : ::stat(out.temp_path().c_str(), &st) == 0 && uint64_t(st.st_size) >= bytes;
+  if (!wrote) throw std::runtime_error(path + ": writing failed: the file came out incomplete (disk full?); nothing was "
+                                       "written under this name");
+  if (!printed.empty()) std::fputs(printed.c_str(), stderr);   // niftilib's warnings on a good write
   out.commit();
 }
 

@@ -1,0 +1,63 @@
+// A disk that fills during `pneumo warp` (issue "Nothing lost, nothing silently wrong"): niftilib
+// writes through gzwrite without checking it, and once left a truncated deformed_ct.nii.gz under its
+// final name, with two of its own error lines naming a temporary file. The disk is filled here by
+// a file-size limit on the process (RLIMIT_FSIZE, SIGXFSZ ignored, so writes past it fail with
+// EFBIG as on a full disk), which needs no mount and cannot touch anything else.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include "cli_test_support.h"
+#include "io_test_support.h"
+#include "tiny_case_support.h"
+
+namespace pneumo {
+namespace {
+
+using namespace testing_support;
+namespace fs = std::filesystem;
+
+/// `pneumo ARGS` with writes limited to `kib` KiB per file.
+CliResult run_pneumo_with_file_limit(int kib, const std::string& args) {
+  ScratchDir tmp;
+  const std::string out = tmp.file("stdout.txt"), err = tmp.file("stderr.txt");
+  const std::string inner = "trap '' XFSZ; ulimit -f " + std::to_string(kib) + "; exec " + PNEUMO_CLI_PATH + " " + args;
+  const std::string cmd = "bash -c \"" + inner + "\" >" + out + " 2>" + err + " </dev/null";
+  const int status = std::system(cmd.c_str());
+  CliResult r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+TEST(FullDisk, AWarpThatCannotWriteItsCtLeavesNoFileUnderItsNameAndSaysWhich) {
+  ScratchDir d;
+  // Tissue with texture (±100 HU), as a CT has: its deformed CT does not compress below the limit.
+  Volume ct = tiny_case_ct();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> noise(-100.0f, 100.0f);
+  for (int64_t n = 0; n < ct.voxel_count(); ++n)
+    if (ct.data<float>()[n] > -1000.0f) ct.data<float>()[n] += noise(rng);
+  const std::string scene = write_tiny_case(d, tiny_case_scene_json(), ct);
+  ASSERT_EQ(run_pneumo("-q simulate " + scene + " --out " + d.file("out")).code, 0);
+  const std::string metrics_before = slurp(d.file("out/metrics.json"));
+  const auto before = tree(d.path() / "out");
+  // 1 KiB a file: the simulation's files are already there; the deformed CT (a few KiB) is written first.
+  const CliResult r = run_pneumo_with_file_limit(1, "-q warp " + scene + " --out " + d.file("out"));
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("deformed_ct.nii.gz: writing failed"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("** ERROR"), std::string::npos) << "niftilib's own lines reached the user: " << r.err;
+  EXPECT_EQ(r.err.find(".tmp"), std::string::npos) << "a temporary name reached the user: " << r.err;
+  EXPECT_EQ(tree(d.path() / "out"), before) << "a file appeared, complete-looking or temporary";
+  EXPECT_EQ(slurp(d.file("out/metrics.json")), metrics_before);
+  // Without the limit the same warp writes it whole (the control: the case itself is fine).
+  const CliResult ok = run_pneumo("-q warp " + scene + " --out " + d.file("out"));
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_TRUE(fs::exists(d.file("out/deformed_ct.nii.gz")));
+}
+
+}  // namespace
+}  // namespace pneumo
