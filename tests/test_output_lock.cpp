@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "cli_test_support.h"
 #include "core/error.h"
@@ -53,6 +54,23 @@ TEST(OutputLock, FoldersItCreatedGoWhenLeftEmptyAndStayWithResults) {
   fs::create_directories(d.file("kept"));
   { const OutputFolderLock lock(d.file("kept")); }
   EXPECT_TRUE(fs::is_directory(d.file("kept"))) << "a folder the lock did not create was removed";
+}
+
+TEST(OutputLock, TemporariesAKilledRunLeftAreRemovedByTheNextLockAndNothingElse) {
+  // AtomicFile's temporary names, at the top of --out and in a views folder below, as kill -9 leaves
+  // them; beside them files that only look alike, which are not pneumo's to remove.
+  ScratchDir d;
+  fs::create_directories(d.file("out/views"));
+  const std::vector<std::string> stale = {"out/.deformed_labels.nii.gz.tmp4242_0.deformed_labels.nii.gz",
+                                          "out/views/.port.png.tmp17_3.port.png"};
+  const std::vector<std::string> kept = {"out/.hidden", "out/notes.tmp1_2.txt", "out/.a.tmp1_2.b",
+                                         "out/.x.tmp_1.x", "out/metrics.json"};
+  for (const auto& f : stale) testing_support::write_bytes(d.file(f), "");
+  for (const auto& f : kept) testing_support::write_bytes(d.file(f), "{}");
+  const OutputFolderLock lock(d.file("out"));
+  EXPECT_EQ(lock.removed_temporaries(), 2);
+  for (const auto& f : stale) EXPECT_FALSE(fs::exists(d.file(f))) << f;
+  for (const auto& f : kept) EXPECT_TRUE(fs::exists(d.file(f))) << f;
 }
 
 TEST(OutputLock, EveryWritingCommandRefusesAFolderAnotherProcessHolds) {

@@ -5,16 +5,37 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/log.h"
 
 namespace pneumo {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+/// ".NAME.tmpPID_N.NAME", the temporary names AtomicFile gives (atomic_file.cpp).
+bool is_atomic_temporary(const std::string& f) {
+  if (f.size() < 8 || f[0] != '.') return false;
+  const std::size_t tmp = f.find(".tmp", 1);
+  if (tmp == std::string::npos) return false;
+  const std::string name = f.substr(1, tmp - 1);
+  std::size_t i = tmp + 4;
+  const std::size_t pid_start = i;
+  while (i < f.size() && std::isdigit(static_cast<unsigned char>(f[i]))) ++i;
+  if (i == pid_start || i >= f.size() || f[i] != '_') return false;
+  const std::size_t n_start = ++i;
+  while (i < f.size() && std::isdigit(static_cast<unsigned char>(f[i]))) ++i;
+  return i > n_start && f.compare(i, std::string::npos, "." + name) == 0;
+}
+
+}  // namespace
 
 OutputFolderLock::OutputFolderLock(const std::string& dir) {
   check_creatable_folder(dir);
@@ -38,6 +59,17 @@ OutputFolderLock::OutputFolderLock(const std::string& dir) {
       throw file_error(dir, "another pneumo is writing into this folder; wait for it to finish or choose another --out");
     throw file_error(dir, std::string("cannot lock the output folder (") + std::strerror(e) + ")");
   }
+  // kill -9 (or a power cut) mid-write leaves AtomicFile's ".NAME.tmpPID_N.NAME" beside its target,
+  // in --out or a folder below it (views/, flythrough/NAME/): none is being written now.
+  for (auto it = fs::recursive_directory_iterator(target, fs::directory_options::skip_permission_denied, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    if (it.depth() > 3) it.disable_recursion_pending();
+    if (!it->is_regular_file(ec) || !is_atomic_temporary(it->path().filename().string())) continue;
+    std::error_code removed;
+    if (fs::remove(it->path(), removed)) ++removed_;
+  }
+  if (removed_ > 0)
+    log::info(dir + ": removed " + std::to_string(removed_) + " temporary file(s) an interrupted run left");
 }
 
 OutputFolderLock::~OutputFolderLock() {

@@ -11,8 +11,13 @@ namespace pneumo {
 class OutputFolderLock {
  public:
   /// Creates `dir` (and missing parents) when it does not exist, then locks it. InputError (exit 2)
-  /// when another process holds it, naming the folder, or when it cannot be created.
+  /// when another process holds it, naming the folder, or when it cannot be created. Once locked,
+  /// removes the temporary files an earlier process killed mid-write left (AtomicFile's names): no
+  /// other process can be writing them now.
   explicit OutputFolderLock(const std::string& dir);
+
+  /// How many stale temporary files the lock removed.
+  int removed_temporaries() const { return removed_; }
   /// Unlocks; removes the folders it created when they are still empty (a run refused on its input
   /// leaves nothing behind).
   ~OutputFolderLock();
@@ -21,6 +26,7 @@ class OutputFolderLock {
 
  private:
   int fd_ = -1;
+  int removed_ = 0;
   std::vector<std::string> created_;   // outermost first
 };
 
