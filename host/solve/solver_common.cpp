@@ -171,6 +171,33 @@ void Monitor::check_diverged(double max_displacement_m, int64_t step, const std:
   throw DivergedError(os.str(), r_.dt_stable_s);
 }
 
+SolverEta solver_eta(const std::vector<SolveSample>& history, double tolerance, int64_t max_steps,
+                     double seconds_per_step) {
+  SolverEta out;
+  if (history.empty()) return out;
+  const SolveSample& now = history.back();
+  const double budget_s = double(std::max<int64_t>(max_steps - now.step, 0)) * seconds_per_step;
+  if (!(now.residual > tolerance)) return out;   // there: no estimate needed
+  // The slower of the decay rates over the last 5 and the last 20 monitoring samples: an oscillating
+  // residual dips for a few samples at a time, and a dip alone once promised "~0.1 s" to a run that
+  // never converged.
+  double rate = -INFINITY;
+  for (std::size_t back : {std::size_t(4), std::size_t(19)}) {
+    if (history.size() <= back) continue;
+    const SolveSample& old = history[history.size() - 1 - back];
+    if (now.step <= old.step || !(old.residual > 0.0)) continue;
+    rate = std::max(rate, (std::log(now.residual) - std::log(old.residual)) / double(now.step - old.step));
+  }
+  if (history.size() < 5) return out;
+  if (rate < 0.0 && std::isfinite(rate)) out.seconds = (std::log(tolerance) - std::log(now.residual)) / rate * seconds_per_step;
+  // Never past the step budget: the run ends there whatever the residual does.
+  if (out.seconds < 0.0 || out.seconds > budget_s) {
+    out.seconds = budget_s;
+    out.step_limit = true;
+  }
+  return out;
+}
+
 bool Monitor::record(int64_t step, double time_s, double pressure_pa, double residual, const std::vector<Vec3>& x,
                      const std::vector<Vec3>& v) {
   return record(step, time_s, pressure_pa, residual, max_displacement(x), v.empty() ? 0.0 : max_speed(v),
@@ -203,18 +230,13 @@ bool Monitor::record(int64_t step, double time_s, double pressure_pa, double res
   std::snprintf(detail, sizeof detail, "residual %.2e (target %.0e)  P %.1f mmHg  max displacement %.1f mm",
                 residual, opt_.residual_tolerance, pressure_pa / units::kPaPerMmHg,
                 units::m_to_mm(s.max_displacement_m));
-  // ETA from the residual's recent decay rate (log-linear), once it is falling.
-  double eta = -1.0;
-  const std::size_t h = r_.history.size();
-  if (h >= 5 && residual > opt_.residual_tolerance) {
-    const SolveSample& old = r_.history[h - 5];
-    const double rate = (std::log(residual) - std::log(old.residual)) / double(step - old.step);
-    const double seconds_per_step =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count() / double(step);
-    if (rate < 0.0 && std::isfinite(rate))
-      eta = (std::log(opt_.residual_tolerance) - std::log(residual)) / rate * seconds_per_step;
-  }
-  if (opt_.progress) progress_.update(step, detail, eta);
+  const double seconds_per_step =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count() / double(std::max<int64_t>(step, 1));
+  const SolverEta eta = solver_eta(r_.history, opt_.residual_tolerance, opt_.max_steps, seconds_per_step);
+  std::string shown = detail;
+  // During a dynamic scheme's ramp the residual grows with the load: no cause for a warning yet.
+  if (eta.step_limit && time_s >= opt_.ramp_s) shown += "  (at this rate the run ends at solver.max_steps)";
+  if (opt_.progress) progress_.update(step, shown, eta.seconds);
   if (opt_.on_snapshot && opt_.snapshot_every_steps > 0 && step >= next_snapshot_) {
     opt_.on_snapshot(SolverSnapshot{step, time_s, pressure_pa, positions()});
     next_snapshot_ = (step / opt_.snapshot_every_steps + 1) * opt_.snapshot_every_steps;

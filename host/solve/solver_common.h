@@ -16,6 +16,16 @@ namespace pneumo::detail {
 
 class Monitor;
 
+/// The progress line's ETA (seconds; < 0: none yet) from the residual history: log-linear decay to
+/// `tolerance` at the slower of the recent rates, never beyond the time left to `max_steps`;
+/// `step_limit` when that budget is what bounds it (the residual is not falling fast enough).
+struct SolverEta {
+  double seconds = -1.0;
+  bool step_limit = false;
+};
+SolverEta solver_eta(const std::vector<SolveSample>& history, double tolerance, int64_t max_steps,
+                     double seconds_per_step);
+
 // ---- shared by the CPU reference and the device solvers ----------------------------------------
 
 /// FIRE's parameters (Bitzek 2006 / Guénolé 2020 defaults), in pseudo-time units where ω_max ≤ √2.

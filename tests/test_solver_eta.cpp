@@ -1,0 +1,56 @@
+// The solver's ETA (solver_common.h, solver_eta): a residual decaying geometrically gets the closed
+// form's time to the tolerance; a residual that dips for a few samples but has not fallen over the
+// last twenty, or falls too slowly, gets the time left to solver.max_steps, flagged, never less (a
+// run of 65,000 steps once showed "ETA ~0.1 s" throughout).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "solve/solver_common.h"
+
+namespace pneumo::detail {
+namespace {
+
+std::vector<SolveSample> history(int samples, int every, double (*residual)(int64_t step)) {
+  std::vector<SolveSample> h;
+  for (int i = 1; i <= samples; ++i) {
+    SolveSample s;
+    s.step = int64_t(i) * every;
+    s.residual = residual(s.step);
+    h.push_back(s);
+  }
+  return h;
+}
+
+TEST(SolverEta, GeometricDecayGivesTheClosedFormsTimeToTheTolerance) {
+  // r = e^(−0.01 step): from step 300 (r = e^−3) to 1e-3 takes (ln 1e3 − 3) / 0.01 = 390.8 steps.
+  const auto h = history(30, 10, [](int64_t step) { return std::exp(-0.01 * double(step)); });
+  const SolverEta eta = solver_eta(h, 1e-3, 1000000, 2e-3);
+  const double expected = (std::log(1e3) - 3.0) / 0.01 * 2e-3;
+  EXPECT_NEAR(eta.seconds, expected, 1e-9 * expected);
+  EXPECT_FALSE(eta.step_limit);
+}
+
+TEST(SolverEta, ADipOfAnOscillatingResidualPromisesNothingBeyondTheStepBudget) {
+  // Rising over the last 20 samples, falling over the last 5: the budget bounds it.
+  const auto h = history(40, 10, [](int64_t step) {
+    return 1e-2 * std::exp(0.002 * double(step)) * (step > 350 ? 1.0 - 0.05 * double(step - 350) / 10.0 : 1.0);
+  });
+  const SolverEta eta = solver_eta(h, 1e-3, 2000, 1e-3);
+  EXPECT_TRUE(eta.step_limit);
+  EXPECT_DOUBLE_EQ(eta.seconds, (2000 - 400) * 1e-3);
+}
+
+TEST(SolverEta, ASlowFallIsCappedAtTheStepBudgetAndFewSamplesGiveNone) {
+  const auto slow = history(30, 10, [](int64_t step) { return std::exp(-1e-5 * double(step)); });
+  const SolverEta eta = solver_eta(slow, 1e-3, 1000, 1e-3);
+  EXPECT_TRUE(eta.step_limit);
+  EXPECT_DOUBLE_EQ(eta.seconds, (1000 - 300) * 1e-3);
+  EXPECT_LT(solver_eta(history(3, 10, [](int64_t) { return 1.0; }), 1e-3, 1000, 1e-3).seconds, 0.0);
+  EXPECT_LT(solver_eta(history(30, 10, [](int64_t) { return 1e-4; }), 1e-3, 1000, 1e-3).seconds, 0.0)
+      << "at the tolerance already: no estimate";
+}
+
+}  // namespace
+}  // namespace pneumo::detail
