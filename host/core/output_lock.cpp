@@ -51,7 +51,16 @@ OutputFolderLock::OutputFolderLock(const std::string& dir) {
   }
   fd_ = ::open(target.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd_ < 0) throw file_error(dir, std::string("cannot open the output folder (") + std::strerror(errno) + ")");
-  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+  // A process that has just ended (kill -9 included) can hold the lock a few milliseconds longer:
+  // the kernel releases it when its last reference to the folder goes, which may trail the exit.
+  // Half a second of retries lets a command started right after it in; a process that is still
+  // running is refused after that.
+  int rc = ::flock(fd_, LOCK_EX | LOCK_NB);
+  for (int tries = 0; rc != 0 && errno == EWOULDBLOCK && tries < 25; ++tries) {
+    ::usleep(20000);
+    rc = ::flock(fd_, LOCK_EX | LOCK_NB);
+  }
+  if (rc != 0) {
     const int e = errno;
     ::close(fd_);
     fd_ = -1;
