@@ -34,11 +34,11 @@ inline std::set<std::string> tree(const std::filesystem::path& root) {
   return out;
 }
 
-/// `pneumo ARGS` with no standard input; its output goes through files in a scratch folder.
-inline CliResult run_pneumo(const std::string& args) {
+/// A shell command line with no standard input; its output goes through files in a scratch folder.
+inline CliResult run_shell(const std::string& command) {
   ScratchDir tmp;
   const std::string out = tmp.file("stdout.txt"), err = tmp.file("stderr.txt");
-  const std::string cmd = std::string(PNEUMO_CLI_PATH) + " " + args + " >" + out + " 2>" + err + " </dev/null";
+  const std::string cmd = command + " >" + out + " 2>" + err + " </dev/null";
   const int status = std::system(cmd.c_str());
   CliResult r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
@@ -46,5 +46,8 @@ inline CliResult run_pneumo(const std::string& args) {
   r.err = slurp(err);
   return r;
 }
+
+/// `pneumo ARGS`, as run_shell runs it.
+inline CliResult run_pneumo(const std::string& args) { return run_shell(std::string(PNEUMO_CLI_PATH) + " " + args); }
 
 }  // namespace pneumo::testing_support

@@ -21,16 +21,8 @@ namespace fs = std::filesystem;
 
 /// `pneumo ARGS` with writes limited to `kib` KiB per file.
 CliResult run_pneumo_with_file_limit(int kib, const std::string& args) {
-  ScratchDir tmp;
-  const std::string out = tmp.file("stdout.txt"), err = tmp.file("stderr.txt");
-  const std::string inner = "trap '' XFSZ; ulimit -f " + std::to_string(kib) + "; exec " + PNEUMO_CLI_PATH + " " + args;
-  const std::string cmd = "bash -c \"" + inner + "\" >" + out + " 2>" + err + " </dev/null";
-  const int status = std::system(cmd.c_str());
-  CliResult r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
+  return run_shell("bash -c \"trap '' XFSZ; ulimit -f " + std::to_string(kib) + "; exec " + PNEUMO_CLI_PATH + " " + args +
+                   "\"");
 }
 
 TEST(FullDisk, AWarpThatCannotWriteItsCtLeavesNoFileUnderItsNameAndSaysWhich) {
