@@ -33,7 +33,7 @@ __kernel void explicit_step(__global float4* restrict x, __global float4* restri
   x[i] += dt * vi;
 }
 
-// Per group: max free |F| component, max |v|, max |u| (INFINITY for any non-finite displacement).
+// Per group: max free |F| component, max |v|, max |u| (INFINITY for any non-finite force or displacement).
 __kernel void monitor(__global const float4* restrict f, __global const float4* restrict v,
                       __global const float4* restrict x, __global const float4* restrict hold, const int n,
                       __global float4* restrict partial) {
@@ -41,10 +41,14 @@ __kernel void monitor(__global const float4* restrict f, __global const float4* 
   const int i = get_global_id(0), l = get_local_id(0);
   float4 m = (float4)(0.0f);
   if (i < n) {
-    const float4 fh = fabs(f[i] * hold[i]);
+    // Free components only (a held axis reads 0 whatever its force), and INFINITY for a non-finite
+    // one: fmax drops NaN, which would let a NaN force pass as a small residual.
+    const float4 fh = select((float4)(0.0f), fabs(f[i]), isnotequal(hold[i], (float4)(0.0f)));
+    const bool forces_finite = isfinite(fh.x) && isfinite(fh.y) && isfinite(fh.z);
     const float3 d = x[i].xyz;
     const bool finite = isfinite(x[i].x) && isfinite(x[i].y) && isfinite(x[i].z);
-    m = (float4)(fmax(fh.x, fmax(fh.y, fh.z)), length(v[i].xyz), finite ? length(d) : INFINITY, 0.0f);
+    m = (float4)(forces_finite ? fmax(fh.x, fmax(fh.y, fh.z)) : INFINITY, length(v[i].xyz),
+                 finite ? length(d) : INFINITY, 0.0f);
   }
   s[l] = m;
   const float4 group = reduce_group(s, l, 1);
