@@ -33,7 +33,8 @@ Run add_render(CLI::App& app) {
     opt.out_dir = o->out;
     opt.backend = parse_gl_backend(o->backend);
     opt.cpu_reference = o->cpu;
-    // Checked now, created by the render only once the volumes are read and every pose is valid.
+    // Checked now; the render writes into it only once the volumes are read and every pose is valid
+    // (the lock above created it if missing and removes it again if nothing was written).
     check_creatable_folder(o->out);
     // After simulate and warp into the same folder, ports travel with the skin through the solved shape.
     std::unique_ptr<DeformedMesh> deformed;

@@ -50,8 +50,8 @@ void check_output_folder(const RunOptions& o) {
   check_creatable_folder(o.out_dir);
 }
 
-/// Creates --out and removes an earlier run's files: only once the inputs have been read and checked,
-/// so that bad input leaves an earlier run's results as they were.
+/// Removes an earlier run's files (the CLI's lock has created --out if it was missing): only once the
+/// inputs have been read and checked, so that bad input leaves an earlier run's results as they were.
 void prepare_folder(const RunOptions& o) {
   const fs::path out(o.out_dir);
   std::error_code ec;
