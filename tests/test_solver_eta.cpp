@@ -42,6 +42,21 @@ TEST(SolverEta, ADipOfAnOscillatingResidualPromisesNothingBeyondTheStepBudget) {
   EXPECT_DOUBLE_EQ(eta.seconds, (2000 - 400) * 1e-3);
 }
 
+TEST(SolverEta, OfTwoFallingRatesTheSlowerIsTaken) {
+  // Falling at 0.001 per step up to step 350, then at 0.01: the last 5 samples (steps 360-400) fall
+  // at 0.01, the last 20 (210-400) at (14 × 0.001 + 5 × 0.01) / 19 per step.
+  const auto h = history(40, 10, [](int64_t step) {
+    const double s = double(step);
+    return std::exp(-(s <= 350 ? 0.001 * s : 0.35 + 0.01 * (s - 350)));
+  });
+  const double slower = (140 * 0.001 + 50 * 0.01) / 190.0;
+  const double r_now = std::exp(-(0.35 + 0.5));
+  const SolverEta eta = solver_eta(h, 1e-3, 1000000, 1e-3);
+  const double expected = (std::log(r_now) - std::log(1e-3)) / slower * 1e-3;
+  EXPECT_NEAR(eta.seconds, expected, 1e-9 * expected);
+  EXPECT_FALSE(eta.step_limit);
+}
+
 TEST(SolverEta, ASlowFallIsCappedAtTheStepBudgetAndFewSamplesGiveNone) {
   const auto slow = history(30, 10, [](int64_t step) { return std::exp(-1e-5 * double(step)); });
   const SolverEta eta = solver_eta(slow, 1e-3, 1000, 1e-3);

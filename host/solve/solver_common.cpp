@@ -234,8 +234,10 @@ bool Monitor::record(int64_t step, double time_s, double pressure_pa, double res
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count() / double(std::max<int64_t>(step, 1));
   const SolverEta eta = solver_eta(r_.history, opt_.residual_tolerance, opt_.max_steps, seconds_per_step);
   std::string shown = detail;
-  // During a dynamic scheme's ramp the residual grows with the load: no cause for a warning yet.
-  if (eta.step_limit && time_s >= opt_.ramp_s) shown += "  (at this rate the run ends at solver.max_steps)";
+  // During a dynamic scheme's ramp the residual grows with the load: no cause for a warning yet. The
+  // static schemes (time 0, no time step) step their load in increments instead.
+  const bool ramping = r_.dt_s > 0.0 && time_s < opt_.ramp_s;
+  if (eta.step_limit && !ramping) shown += "  (at this rate the run ends at solver.max_steps)";
   if (opt_.progress) progress_.update(step, shown, eta.seconds);
   if (opt_.on_snapshot && opt_.snapshot_every_steps > 0 && step >= next_snapshot_) {
     opt_.on_snapshot(SolverSnapshot{step, time_s, pressure_pa, positions()});
@@ -273,7 +275,8 @@ std::optional<StopReason> Monitor::check_dynamic(int64_t step, double time_s, do
 void Monitor::finish(const std::vector<Vec3>& x, const std::vector<Vec3>& v, int64_t steps, int64_t force_evaluations,
                      StopReason stop_reason, double residual) {
   // Whatever the scheme checked on the way, no result with a non-finite position leaves a solver.
-  check_diverged(max_displacement(x), steps, std::string(kLoadAdvice));
+  // (A finite one beyond the model's size was the schemes' to catch, with their own advice.)
+  if (const double d = max_displacement(x); !std::isfinite(d)) check_diverged(d, steps, std::string(kLoadAdvice));
   r_.x = x;
   r_.v = v.empty() ? std::vector<Vec3>(x.size(), Vec3::Zero()) : v;
   r_.steps = steps;
