@@ -115,7 +115,14 @@ class CapturedStderr {
     std::fflush(stderr);
     saved_ = ::dup(2);
     file_ = std::tmpfile();
-    if (saved_ >= 0 && file_) ::dup2(::fileno(file_), 2);
+    if (saved_ >= 0 && file_) {
+      ::dup2(::fileno(file_), 2);
+    } else {   // nowhere to put it: leave stderr as it is
+      if (file_) std::fclose(file_);
+      if (saved_ >= 0) ::close(saved_);
+      file_ = nullptr;
+      saved_ = -1;
+    }
   }
   ~CapturedStderr() { restore(); }
   /// Restores stderr; returns what was printed meanwhile.
