@@ -5,10 +5,11 @@
 //  - Whole-voxel translation: warp_cpu equals the reference bit for bit (exact by construction).
 //  - Smooth random deformations, seeded, at two cube sizes, with wall and viscera separating and
 //    pressing into each other, tetrahedra numbered both ways: where both carry a voxel the CT
-//    agrees within 1e-3 HU (both in double; warp_cpu adds its source point up along the row, the
+//    agrees within 2e-4 HU (both in double; warp_cpu adds its source point up along the row, the
 //    reference evaluates it per voxel: ~1e-12 voxel apart, which the float result hides but for
-//    an ulp, 1e-4 HU at 1500 HU); outcome and label equal except at measured ties (a weight within
-//    1e-5 of −tolerance, a source coordinate within 1e-4 of a half). Every mismatch must be a tie.
+//    an ulp, 1.2e-4 HU at 1500 HU); outcome and label equal at every voxel: the tie bands of the
+//    float32 kernel's test (measured_tie) are 10^7 times wider than the two differ, so no voxel of
+//    these trials lies in one, and none may differ.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -86,8 +87,9 @@ TEST_F(WarpReference, TheFastCpuWarpEqualsItOnRandomDeformationsExceptAtMeasured
     const WarpComparison cmp = compare_warps(ref, fast, m, box);
     EXPECT_GT(cmp.both_carried, 2000);
     EXPECT_GT(ref.gas_voxels, 0);
-    EXPECT_LE(cmp.worst_hu, 1e-3) << "max CT difference (HU)";
+    EXPECT_LE(cmp.worst_hu, 2e-4) << "max CT difference (HU)";
     EXPECT_EQ(cmp.untied, 0) << "voxels whose outcome or label differ without a tie";
+    EXPECT_EQ(cmp.ties, 0) << "voxels whose outcome or label differ, excused as ties";
     std::printf("seed %u: %lld voxels carried by both, max |dHU| %.2e, %lld tie mismatches\n", trial.seed,
                 (long long)cmp.both_carried, cmp.worst_hu, (long long)cmp.ties);
   }
