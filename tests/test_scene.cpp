@@ -575,7 +575,7 @@ TEST(SceneFiles, DeepNestingAndHugeFilesAreRefusedBeforeParsing) {
     load_scene(big);
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_CONTAINS(e.what(), "big.json: is 17 MB; a scene file is at most 16 MB");
+    EXPECT_CONTAINS(e.what(), "big.json: is " + std::to_string((17u << 20) + 12) + " bytes; a scene file is at most 16777216");
   }
 }
 

@@ -78,8 +78,8 @@ bool Geometry::same_grid(const Geometry& o, double tol_mm) const {
 void Geometry::validate(const std::string& what) const {
   // Bounds that keep every size computed from the dimensions (voxels, bytes, padded and working
   // grids) far inside int64: a header promising 2^32 × 2^32 × 16 voxels multiplies to 0 in 64 bits
-  // and would pass every later check. 2^20 voxels an axis and 2^36 in all are 100 times a
-  // 0.25 mm whole-body CT (2000 × 2000 × 8000 = 3.2·10^10 is the largest imaginable).
+  // and would pass every later check. 2^20 voxels an axis and 2^36 ≈ 6.9·10^10 in all: twice a
+  // 0.25 mm whole-body CT (2000 × 2000 × 8000 = 3.2·10^10, the largest imaginable).
   constexpr int64_t kMaxAxis = int64_t(1) << 20, kMaxVoxels = int64_t(1) << 36;
   for (int a = 0; a < 3; ++a) {
     if (dims[a] < 1 || dims[a] > kMaxAxis) {

@@ -136,8 +136,8 @@ json read_json_file(const std::string& path) {
   std::error_code size_error;
   const std::uintmax_t bytes = std::filesystem::file_size(path, size_error);
   if (!size_error && bytes > kMaxSceneBytes)
-    throw file_error(path, "is " + std::to_string(bytes >> 20) + " MB; a scene file is at most " +
-                               std::to_string(kMaxSceneBytes >> 20) + " MB (scenes are a few kB)");
+    throw file_error(path, "is " + std::to_string(bytes) + " bytes; a scene file is at most " +
+                               std::to_string(kMaxSceneBytes) + " (16 MB; scenes are a few kB)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw file_error(path, std::string("cannot open the scene file (") + std::strerror(errno) + ")");
   std::ostringstream buffer;

@@ -1,4 +1,4 @@
-// Must compile: solve declares mesh (and, through it, scene and core). The control that shows the
+// Must compile: solve declares mesh (and, through it, core and domain). The control that shows the
 // failing probes fail for the layering, not for a broken compile line.
 #include "mesh/mesh.h"
 #include "solve/solver.h"
