@@ -57,9 +57,7 @@ TEST_P(WarpClVsCpu, WholeVoxelTranslationEqualsTheReferenceBitForBit) {
   const WarpMesh m = make_warp_mesh(c.mesh, uniform_displacement(c, Vec3(-2, 3, 1)));
   const WarpResult ref = warp_cpu(m, c.source(), c.whole(), options());
   const WarpResult dev = warp_opencl(*ctx_, m, c.source(), c.whole(), options());
-  EXPECT_EQ(std::memcmp(ref.ct_hu.data(), dev.ct_hu.data(), ref.ct_hu.size() * sizeof(float)), 0);
-  EXPECT_EQ(ref.labels, dev.labels);
-  EXPECT_EQ(ref.outcome, dev.outcome);
+  expect_same_bits(ref, dev);
   EXPECT_GT(ref.gas_voxels, 0);
   EXPECT_GT(ref.carried_voxels, 0);
 }
@@ -69,11 +67,7 @@ TEST_P(WarpClVsCpu, WholeVoxelTranslationEqualsTheReferenceBitForBit) {
 TEST_P(WarpClVsCpu, AffineMatchesAnalyticResamplingWithNoCracks) {
   const AffineCase a = affine_case();
   const WarpResult r = warp_opencl(*ctx_, a.mesh, a.c.source(), a.c.whole(), options());
-  const AffineCheck check = check_affine(a, r, 1e-4);
-  EXPECT_GT(check.checked, 3000);
-  EXPECT_EQ(check.cracks, 0) << "voxels inside the deformed mesh left uncovered";
-  EXPECT_LE(check.worst_hu, kHuTolerance) << "HU off analytic affine resampling";
-  EXPECT_EQ(check.label_mismatches, 0) << "labels off the nearest source voxel";
+  const AffineCheck check = expect_affine_truth(a, r, 1e-4, kHuTolerance);
   std::printf("%s affine: %lld voxels checked, max |Δ| %.2e HU, %lld nearest-label ties skipped\n", r.device.c_str(),
               (long long)check.checked, check.worst_hu, (long long)check.label_ties);
 }
@@ -102,10 +96,8 @@ TEST_P(WarpClVsCpu, RandomDeformationEqualsTheReferenceExceptAtMeasuredTies) {
     for (int chunk : {1, 7, 32}) {
       WarpOptions o = options();
       o.row_chunk = chunk;
-      const WarpResult other = warp_opencl(*ctx_, m, c.source(), box, o);
-      EXPECT_EQ(std::memcmp(other.ct_hu.data(), dev.ct_hu.data(), dev.ct_hu.size() * sizeof(float)), 0) << chunk;
-      EXPECT_EQ(other.labels, dev.labels) << chunk;
-      EXPECT_EQ(other.outcome, dev.outcome) << chunk;
+      SCOPED_TRACE("row_chunk " + std::to_string(chunk));
+      expect_same_bits(warp_opencl(*ctx_, m, c.source(), box, o), dev);
     }
     const WarpComparison cmp = compare_warps(ref, dev, m, box);
     EXPECT_GT(cmp.both_carried, 2000);

@@ -25,10 +25,7 @@ namespace {
 
 WarpOptions options() { return warp_test_options(); }
 
-class WarpCpu : public ::testing::Test {
- protected:
-  void SetUp() override { Progress::set_enabled(false); }
-};
+class WarpCpu : public QuietWarpTest {};
 
 }  // namespace
 
@@ -95,11 +92,7 @@ TEST_F(WarpCpu, WholeVoxelTranslationShiftsExactly) {
 TEST_F(WarpCpu, AffineMatchesAnalyticResamplingWithNoCracks) {
   const AffineCase a = affine_case();
   const WarpResult r = warp_cpu(a.mesh, a.c.source(), a.c.whole(), options());
-  const AffineCheck check = check_affine(a, r, 1e-6);
-  EXPECT_GT(check.checked, 3000);
-  EXPECT_EQ(check.cracks, 0) << "voxels inside the deformed mesh left uncovered";
-  EXPECT_LE(check.worst_hu, 1e-3) << "HU off analytic affine resampling";
-  EXPECT_EQ(check.label_mismatches, 0) << "labels off the nearest source voxel";
+  const AffineCheck check = expect_affine_truth(a, r, 1e-6, 1e-3);
   std::printf("affine: %lld voxels checked, max |Δ| %.2e HU, %lld nearest-label ties skipped\n",
               (long long)check.checked, check.worst_hu, (long long)check.label_ties);
 }
@@ -172,9 +165,7 @@ TEST_F(WarpCpu, SameBitsOnOneAndTwoThreads) {
   omp_set_num_threads(2);
   const WarpResult two = warp_cpu(m, c.source(), c.whole(), options());
   omp_set_num_threads(before);
-  EXPECT_EQ(std::memcmp(one.ct_hu.data(), two.ct_hu.data(), one.ct_hu.size() * sizeof(float)), 0);
-  EXPECT_EQ(one.labels, two.labels);
-  EXPECT_EQ(one.outcome, two.outcome);
+  expect_same_bits(one, two);
   EXPECT_GT(one.carried_voxels, 0);
 }
 
@@ -203,10 +194,7 @@ TEST_F(WarpCpu, ASeriesOfWarpsGivesWhatFreshWarpsGive) {
     SCOPED_TRACE("step " + std::to_string(n_step++));
     const WarpResult fresh = warp_cpu(*s.mesh, s.src, s.box, options());
     const WarpResult& again = series.warp("cpu", *s.mesh, s.src, s.box, options());
-    ASSERT_EQ(again.ct_hu.size(), fresh.ct_hu.size());
-    EXPECT_EQ(std::memcmp(again.ct_hu.data(), fresh.ct_hu.data(), fresh.ct_hu.size() * sizeof(float)), 0);
-    EXPECT_EQ(again.labels, fresh.labels);
-    EXPECT_EQ(again.outcome, fresh.outcome);
+    expect_same_bits(again, fresh);
     EXPECT_EQ(again.carried_voxels, fresh.carried_voxels);
     EXPECT_EQ(again.gas_voxels, fresh.gas_voxels);
     EXPECT_EQ(again.kept_voxels, fresh.kept_voxels);

@@ -29,10 +29,7 @@ namespace {
 WarpOptions options() { return warp_test_options(); }
 Geometry oblique_grid() { return oblique_test_grid(); }
 
-class WarpReference : public ::testing::Test {
- protected:
-  void SetUp() override { Progress::set_enabled(false); }
-};
+class WarpReference : public QuietWarpTest {};
 
 }  // namespace
 
@@ -51,11 +48,7 @@ TEST_F(WarpReference, IdentityReturnsTheInputBitForBit) {
 TEST_F(WarpReference, AffineMatchesAnalyticResamplingWithNoCracks) {
   const AffineCase a = affine_case();
   const WarpResult r = warp_reference(a.mesh, a.c.source(), a.c.whole(), options());
-  const AffineCheck check = check_affine(a, r, 1e-6);
-  EXPECT_GT(check.checked, 3000);
-  EXPECT_EQ(check.cracks, 0) << "voxels inside the deformed mesh left uncovered";
-  EXPECT_LE(check.worst_hu, 1e-3) << "HU off analytic affine resampling";
-  EXPECT_EQ(check.label_mismatches, 0) << "labels off the nearest source voxel";
+  expect_affine_truth(a, r, 1e-6, 1e-3);
 }
 
 TEST_F(WarpReference, TheFastCpuWarpEqualsItOnAWholeVoxelTranslationBitForBit) {
@@ -63,9 +56,7 @@ TEST_F(WarpReference, TheFastCpuWarpEqualsItOnAWholeVoxelTranslationBitForBit) {
   const WarpMesh m = make_warp_mesh(c.mesh, uniform_displacement(c, Vec3(-2, 3, 1)));
   const WarpResult ref = warp_reference(m, c.source(), c.whole(), options());
   const WarpResult fast = warp_cpu(m, c.source(), c.whole(), options());
-  EXPECT_EQ(std::memcmp(ref.ct_hu.data(), fast.ct_hu.data(), ref.ct_hu.size() * sizeof(float)), 0);
-  EXPECT_EQ(ref.labels, fast.labels);
-  EXPECT_EQ(ref.outcome, fast.outcome);
+  expect_same_bits(ref, fast);
   EXPECT_GT(ref.gas_voxels, 0);
   EXPECT_GT(ref.carried_voxels, 0);
 }

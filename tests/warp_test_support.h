@@ -8,9 +8,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <random>
 #include <vector>
 
+#include "core/progress.h"
 #include "core/units.h"
 #include "mesh/mesh.h"
 #include "warp/warp.h"
@@ -291,6 +293,31 @@ inline WarpComparison compare_warps(const WarpResult& a, const WarpResult& b, co
                                                                                                       : out.untied);
       }
   return out;
+}
+
+/// The warp tests' fixture: no progress lines.
+class QuietWarpTest : public ::testing::Test {
+ protected:
+  void SetUp() override { Progress::set_enabled(false); }
+};
+
+/// Two warps equal bit for bit: CT (as bytes, so -0 and NaN patterns count), labels and outcomes.
+inline void expect_same_bits(const WarpResult& a, const WarpResult& b) {
+  ASSERT_EQ(a.ct_hu.size(), b.ct_hu.size());
+  EXPECT_EQ(std::memcmp(a.ct_hu.data(), b.ct_hu.data(), a.ct_hu.size() * sizeof(float)), 0);
+  EXPECT_EQ(a.labels, b.labels);
+  EXPECT_EQ(a.outcome, b.outcome);
+}
+
+/// The affine closed form held to: more than 3000 voxels checked, no crack, CT within `hu_tolerance`
+/// of the analytic resampling, labels exact outside `half_band` of a half-voxel tie. Returns the check.
+inline AffineCheck expect_affine_truth(const AffineCase& a, const WarpResult& r, double half_band, double hu_tolerance) {
+  const AffineCheck check = check_affine(a, r, half_band);
+  EXPECT_GT(check.checked, 3000);
+  EXPECT_EQ(check.cracks, 0) << "voxels inside the deformed mesh left uncovered";
+  EXPECT_LE(check.worst_hu, hu_tolerance) << "HU off analytic affine resampling";
+  EXPECT_EQ(check.label_mismatches, 0) << "labels off the nearest source voxel";
+  return check;
 }
 
 }  // namespace pneumo::testing_support
