@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cli_test_support.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/output_lock.h"
 #include "io_test_support.h"
@@ -67,8 +68,13 @@ TEST(OutputLock, TemporariesAKilledRunLeftAreRemovedByTheNextLockAndNothingElse)
                                          "out/.x.tmp_1.x", "out/metrics.json"};
   for (const auto& f : stale) testing_support::write_bytes(d.file(f), "");
   for (const auto& f : kept) testing_support::write_bytes(d.file(f), "{}");
+  // The names AtomicFile really gives are the ones recognised.
+  const AtomicFile pending(d.file("out/deformed_ct.nii.gz"));
+  EXPECT_TRUE(is_atomic_temporary_name(fs::path(pending.temp_path()).filename().string())) << pending.temp_path();
+  testing_support::write_bytes(pending.temp_path(), "");
   const OutputFolderLock lock(d.file("out"));
-  EXPECT_EQ(lock.removed_temporaries(), 2);
+  EXPECT_EQ(lock.removed_temporaries(), 3);
+  EXPECT_FALSE(fs::exists(pending.temp_path()));
   for (const auto& f : stale) EXPECT_FALSE(fs::exists(d.file(f))) << f;
   for (const auto& f : kept) EXPECT_TRUE(fs::exists(d.file(f))) << f;
 }

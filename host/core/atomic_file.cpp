@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -45,6 +46,20 @@ void AtomicFile::commit() {
   if (std::rename(temp_.c_str(), target_.c_str()) != 0)
     throw std::runtime_error("cannot rename " + temp_ + " to " + target_ + ": " + std::strerror(errno));
   committed_ = true;
+}
+
+bool is_atomic_temporary_name(const std::string& f) {
+  if (f.size() < 8 || f[0] != '.') return false;
+  const std::size_t tmp = f.find(".tmp", 1);
+  if (tmp == std::string::npos) return false;
+  const std::string name = f.substr(1, tmp - 1);
+  std::size_t i = tmp + 4;
+  const std::size_t pid_start = i;
+  while (i < f.size() && std::isdigit(static_cast<unsigned char>(f[i]))) ++i;
+  if (i == pid_start || i >= f.size() || f[i] != '_') return false;
+  const std::size_t n_start = ++i;
+  while (i < f.size() && std::isdigit(static_cast<unsigned char>(f[i]))) ++i;
+  return i > n_start && f.compare(i, std::string::npos, "." + name) == 0;
 }
 
 void check_writable_target(const std::string& path) {

@@ -26,6 +26,10 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+/// Whether a file name is one AtomicFile gives its temporary files (".NAME.tmpPID_N.NAME"): what a
+/// process killed mid-write leaves, for the next one into the folder to remove (output_lock.h).
+bool is_atomic_temporary_name(const std::string& file_name);
+
 /// Writes `text` to `path` atomically.
 void write_text_file_atomic(const std::string& path, const std::string& text);
 

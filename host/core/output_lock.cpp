@@ -5,7 +5,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -18,24 +17,6 @@ namespace pneumo {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-/// ".NAME.tmpPID_N.NAME", the temporary names AtomicFile gives (atomic_file.cpp).
-bool is_atomic_temporary(const std::string& f) {
-  if (f.size() < 8 || f[0] != '.') return false;
-  const std::size_t tmp = f.find(".tmp", 1);
-  if (tmp == std::string::npos) return false;
-  const std::string name = f.substr(1, tmp - 1);
-  std::size_t i = tmp + 4;
-  const std::size_t pid_start = i;
-  while (i < f.size() && std::isdigit(static_cast<unsigned char>(f[i]))) ++i;
-  if (i == pid_start || i >= f.size() || f[i] != '_') return false;
-  const std::size_t n_start = ++i;
-  while (i < f.size() && std::isdigit(static_cast<unsigned char>(f[i]))) ++i;
-  return i > n_start && f.compare(i, std::string::npos, "." + name) == 0;
-}
-
-}  // namespace
 
 OutputFolderLock::OutputFolderLock(const std::string& dir) {
   check_creatable_folder(dir);
@@ -94,7 +75,7 @@ void OutputFolderLock::remove_stale_temporaries(const std::string& dir, const fs
   }
   for (const fs::path& folder : folders)
     for (const auto& e : fs::directory_iterator(folder, ec)) {
-      if (!e.is_regular_file(ec) || !is_atomic_temporary(e.path().filename().string())) continue;
+      if (!e.is_regular_file(ec) || !is_atomic_temporary_name(e.path().filename().string())) continue;
       std::error_code removed;
       if (fs::remove(e.path(), removed)) ++removed_;
     }
