@@ -617,6 +617,7 @@ Volume read_metaimage(const std::string& path) {
   const uint64_t payload = h.geometry.voxel_count() * voxel_size(h.type);
   const DataLocation d = locate_data(path, h, payload);
 
+  require_volume_memory(path, h.geometry, h.type);
   Volume v(h.geometry, h.type);
   FilePtr f = open_for_reading(path, d.path, d.what);
   seek_to(path, f.get(), d.offset);

@@ -339,6 +339,7 @@ Volume read_nifti(const std::string& path) {
   }
   const Geometry g = geometry_from_nim(path, *nim);
 
+  require_volume_memory(path, g, type);
   Volume v(g, type);
   read_payload(path, static_cast<uint64_t>(nim->iname_offset), payload, v.raw());
   if (swapped) dispatch_voxel_type(type, v.raw(), [&](auto* p) { byte_swap_all(p, v.voxel_count()); });

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/memory_budget.h"
 
 namespace pneumo {
 
@@ -60,6 +61,13 @@ uint64_t checked_payload_bytes(const std::string& path, const int64_t dims[3], s
     total *= static_cast<uint64_t>(dims[a]);
   }
   return total;
+}
+
+void require_volume_memory(const std::string& path, const Geometry& g, VoxelType t) {
+  std::ostringstream what;
+  what << path << ": an image of " << g.dims[0] << " x " << g.dims[1] << " x " << g.dims[2] << " " << voxel_type_name(t)
+       << " voxels";
+  require_memory(uint64_t(g.voxel_count()) * voxel_size(t), what.str(), "crop or resample the image, or free memory");
 }
 
 }  // namespace pneumo

@@ -37,4 +37,9 @@ constexpr uint64_t kMaxVolumeBytes = 32ull << 30;
 /// the payload size in bytes; throws InputError naming `path` otherwise. Overflow-safe.
 uint64_t checked_payload_bytes(const std::string& path, const int64_t dims[3], std::size_t bytes_per_voxel);
 
+/// Before a reader allocates the voxels a header promises: InputError naming `path`, the
+/// dimensions and both figures when they exceed the memory this process may still take
+/// (core/memory_budget.h).
+void require_volume_memory(const std::string& path, const Geometry& g, VoxelType t);
+
 }  // namespace pneumo

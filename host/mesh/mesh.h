@@ -55,7 +55,30 @@ struct MeshOptions {
   int cube_voxels = 8;                     // L
   MeshModel model = MeshModel::WallViscera;
   std::optional<Vec3> roi_min_mm, roi_max_mm;   // cubes whose centre lies outside are not meshed
+  /// What the caller will allocate per node and per tetrahedron once the mesh exists (a solver's
+  /// state), counted in the memory estimate build_mesh checks before it allocates anything.
+  uint64_t reserve_bytes_per_node = 0, reserve_bytes_per_tet = 0;
 };
+
+struct Mesh;
+
+/// What a mesh will hold, counted from the roles in two passes over the voxels without building it.
+struct MeshFootprint {
+  int64_t cubes = 0;           // lattice cubes, meshed or not (build_mesh's scratch covers them all)
+  int64_t part_cubes = 0;      // cubes meshed, once per part that meshes them (5 tetrahedra each)
+  int64_t nodes = 0;           // exact
+  int64_t contact_faces = 0;   // voxel faces of the contact surfaces (ContactFaces' tissue faces)
+  int64_t cavity_faces = 0;    // voxel faces between wall and viscera
+  int64_t fixed_faces = 0;     // faces of bone towards neither bone nor wall (an upper bound)
+  uint64_t bytes = 0;          // the peak build_mesh allocates, plus the reserve of MeshOptions
+};
+/// The estimate build_mesh checks against available_memory() (InputError, exit 2, with both figures).
+MeshFootprint estimate_mesh_footprint(const VoxelRoles& roles, const MeshOptions& opt);
+/// InputError (exit 2) when that estimate exceeds available_memory(), with both figures and the
+/// smallest mesh.cube_voxels that fits.
+void require_mesh_memory(const VoxelRoles& roles, const MeshOptions& opt);
+/// The bytes a built mesh holds (its arrays' capacities): what the estimate must cover.
+uint64_t mesh_bytes(const Mesh& m);
 
 /// The surfaces the contact term keeps apart (solve/contact.h): the viscera's surface (every face of a
 /// viscera voxel towards a voxel that is not viscera), the wall's side of the cavity (every face of a

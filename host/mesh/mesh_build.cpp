@@ -1,10 +1,12 @@
 // Builds the cube/tetrahedron mesh from voxel roles (method.md §3).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <sstream>
 
 #include "core/error.h"
+#include "core/memory_budget.h"
 #include "core/units.h"
 #include "mesh/cube_lattice.h"
 #include "mesh/mesh.h"
@@ -315,7 +317,134 @@ void build_bone_obstacles(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
       }
 }
 
+Lattice lattice_of(const Geometry& g, int L) {
+  Lattice lat;
+  for (int a = 0; a < 3; ++a) lat.cubes[a] = (g.dims[a] + L - 1) / L;
+  return lat;
+}
+
+/// Which parts mesh each cube (bit p: part p): those with a voxel of their role in it, among the
+/// cubes whose centre lies in the region of interest.
+std::vector<uint8_t> meshed_parts(const VoxelRoles& roles, const Lattice& lat, const MeshOptions& opt) {
+  const Geometry& g = roles.geometry;
+  const int L = opt.cube_voxels;
+  const bool with_viscera = opt.model == MeshModel::WallViscera;
+  std::vector<uint8_t> meshed(std::size_t(lat.cubes[0] * lat.cubes[1] * lat.cubes[2]), 0);
+  for (int64_t k = 0; k < g.dims[2]; ++k)
+    for (int64_t j = 0; j < g.dims[1]; ++j)
+      for (int64_t i = 0; i < g.dims[0]; ++i) {
+        const Role r = roles.role[g.linear_index(i, j, k)];
+        if (r == Role::Wall || (with_viscera && r == Role::Viscera))
+          meshed[lat.cube_index(i / L, j / L, k / L)] |= r == Role::Wall ? 1 : 2;
+      }
+  if (opt.roi_min_mm && opt.roi_max_mm)
+    for (int64_t c = 0; c < lat.cubes[2]; ++c)
+      for (int64_t b = 0; b < lat.cubes[1]; ++b)
+        for (int64_t a = 0; a < lat.cubes[0]; ++a) {
+          const Vec3 centre = g.to_world(Vec3((a + 0.5) * L - 0.5, (b + 0.5) * L - 0.5, (c + 0.5) * L - 0.5));
+          if (!(centre.array() >= opt.roi_min_mm->array()).all() || !(centre.array() <= opt.roi_max_mm->array()).all())
+            meshed[lat.cube_index(a, b, c)] = 0;
+        }
+  return meshed;
+}
+
 }  // namespace
+
+MeshFootprint estimate_mesh_footprint(const VoxelRoles& roles, const MeshOptions& opt) {
+  const Geometry& g = roles.geometry;
+  const int L = opt.cube_voxels;
+  if (L < 1) throw InputError("mesh.cube_voxels must be at least 1");
+  const Lattice lat = lattice_of(g, L);
+  const std::vector<uint8_t> meshed = meshed_parts(roles, lat, opt);
+  MeshFootprint fp;
+  fp.cubes = int64_t(meshed.size());
+  std::vector<uint8_t> corner(std::size_t(lat.node_count()), 0);   // bit p: part p has a node here
+  for (int64_t c = 0; c < lat.cubes[2]; ++c)
+    for (int64_t b = 0; b < lat.cubes[1]; ++b)
+      for (int64_t a = 0; a < lat.cubes[0]; ++a) {
+        const uint8_t parts = meshed[lat.cube_index(a, b, c)];
+        if (!parts) continue;
+        fp.part_cubes += (parts & 1) + (parts >> 1);
+        for (int k = 0; k < 8; ++k) {
+          const auto o = lattice::corner_offset(k);
+          corner[lat.node_index(a + o[0], b + o[1], c + o[2])] |= parts;
+        }
+      }
+  for (uint8_t parts : corner) fp.nodes += (parts & 1) + (parts >> 1);
+  // The faces the loads and contacts sit on (build_pressure_loads, build_bone_obstacles): viscera
+  // towards anything else, wall towards viscera (the cavity's faces among them), bone towards
+  // neither bone nor wall (counted whether or not viscera are near: an upper bound).
+  const bool with_viscera = opt.model == MeshModel::WallViscera;
+  for (int64_t k = 0; k < g.dims[2]; ++k)
+    for (int64_t j = 0; j < g.dims[1]; ++j)
+      for (int64_t i = 0; i < g.dims[0]; ++i) {
+        const Role r = roles.role[g.linear_index(i, j, k)];
+        if (r == Role::Other || (r == Role::Fixed && !with_viscera)) continue;
+        const int64_t at[3] = {i, j, k};
+        for (int axis = 0; axis < 3; ++axis)
+          for (int side = -1; side <= 1; side += 2) {
+            int64_t n[3] = {at[0], at[1], at[2]};
+            n[axis] += side;
+            if (n[axis] < 0 || n[axis] >= g.dims[axis]) continue;
+            const Role beyond = roles.role[g.linear_index(n[0], n[1], n[2])];
+            if (r == Role::Fixed) fp.fixed_faces += beyond != Role::Fixed && beyond != Role::Wall;
+            else if (r == Role::Viscera) fp.contact_faces += beyond != Role::Viscera;
+            else fp.contact_faces += beyond == Role::Viscera;
+            fp.cavity_faces += (r == Role::Wall && beyond == Role::Viscera) || (r == Role::Viscera && beyond == Role::Wall);
+          }
+      }
+  // Bytes. Arrays filled by push_back may hold up to twice their size (the growth factor 2); what is
+  // gathered per slab and then appended exists in both while it is appended.
+  const uint64_t tets = 5 * uint64_t(fp.part_cubes);
+  const uint64_t springs = 3 * uint64_t(fp.nodes) + 6 * uint64_t(fp.part_cubes);   // axis edges + face diagonals
+  const uint64_t loads = std::min<uint64_t>(uint64_t(fp.cavity_faces), tets);      // one per tetrahedron at most
+  const uint64_t lattice_scratch = uint64_t(fp.cubes) * (sizeof(CubeContent) + 1 + 1 + 2 * sizeof(int32_t)) +
+                                   uint64_t(lat.node_count()) * 2 * sizeof(int32_t);
+  const uint64_t per_tet = 2 * (sizeof(std::array<int32_t, 4>) + sizeof(Part) + sizeof(uint16_t) + 5 * sizeof(double) +
+                                sizeof(std::array<int32_t, 6>)) +
+                           6 * sizeof(std::pair<int64_t, int64_t>);   // the edge sort, reserved exactly
+  const uint64_t per_node =
+      2 * (sizeof(Vec3) + sizeof(Part) + sizeof(uint8_t) + sizeof(std::array<int32_t, 3>) + sizeof(double));
+  const uint64_t per_spring = 2 * (sizeof(std::array<int32_t, 2>) + 3 * sizeof(double));
+  const uint64_t per_contact_face = 4 * (sizeof(int32_t) + sizeof(std::array<double, 4>) + sizeof(Vec3) + sizeof(Part));
+  const uint64_t per_load = 2 * (sizeof(int32_t) + 2 * sizeof(std::array<Vec3, 4>) + sizeof(int64_t));
+  fp.bytes = lattice_scratch + tets * (per_tet + opt.reserve_bytes_per_tet) +
+             uint64_t(fp.nodes) * (per_node + opt.reserve_bytes_per_node) + springs * per_spring +
+             uint64_t(fp.contact_faces) * per_contact_face + loads * per_load +
+             uint64_t(fp.fixed_faces) * 4 * 2 * sizeof(Vec3);
+  return fp;
+}
+
+void require_mesh_memory(const VoxelRoles& roles, const MeshOptions& opt) {
+  const MemoryBudget budget = available_memory();
+  const uint64_t need = estimate_mesh_footprint(roles, opt).bytes;
+  if (need <= budget.bytes) return;
+  // The smallest coarsening that fits (each estimate is two passes over the voxels, well under the
+  // time the refused build would have taken).
+  std::string advice = "narrow the region of interest (mesh.roi_min_mm, mesh.roi_max_mm)";
+  for (int L = opt.cube_voxels + 1; L <= 4 * opt.cube_voxels + 4; ++L) {
+    MeshOptions coarser = opt;
+    coarser.cube_voxels = L;
+    const uint64_t b = estimate_mesh_footprint(roles, coarser).bytes;
+    if (b > budget.bytes) continue;
+    char mm[32];
+    std::snprintf(mm, sizeof mm, "%g", L * roles.geometry.spacing_mm.maxCoeff());
+    advice = "raise mesh.cube_voxels to " + std::to_string(L) + " (mesh.cube_mm " + mm + ", about " + format_bytes(b) +
+             ") or " + advice;
+    break;
+  }
+  require_memory(need, budget, "the mesh of " + std::to_string(opt.cube_voxels) + "-voxel cubes", advice);
+}
+
+uint64_t mesh_bytes(const Mesh& m) {
+  auto held = [](const auto& v) { return uint64_t(v.capacity()) * sizeof(v[0]); };
+  const ContactFaces& c = m.contact;
+  return held(m.rest_m) + held(m.node_part) + held(m.hold) + held(m.node_lattice) + held(m.mass_kg) + held(m.tets) +
+         held(m.tet_part) + held(m.tet_label) + held(m.tet_fraction) + held(m.tet_cube) + held(m.tet_rest_volume_m3) +
+         held(m.tet_young_pa) + held(m.tet_poisson) + held(m.tet_springs) + held(m.springs) + held(m.spring_rest_m) +
+         held(m.spring_k) + held(m.spring_c) + held(m.load_tet) + held(m.load_c) + held(c.tet) + held(c.w) + held(c.c) +
+         held(c.part) + held(c.fixed_centre_m) + held(c.fixed_area_m2);
+}
 
 Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const std::function<double(Role, int)>& young_pa_for) {
   return build_mesh(roles, opt, VoxelYoungFn([&](Role r, int label, float) { return young_pa_for(r, label); }));
@@ -325,28 +454,14 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
   const Geometry& g = roles.geometry;
   const int L = opt.cube_voxels;
   if (L < 1) throw InputError("mesh.cube_voxels must be at least 1");
-  Lattice lat;
-  for (int a = 0; a < 3; ++a) lat.cubes[a] = (g.dims[a] + L - 1) / L;
+  const Lattice lat = lattice_of(g, L);
+  require_mesh_memory(roles, opt);
 
   const std::vector<CubeContent> content = classify_cubes(roles, lat, L, young_pa_for);
   const std::array<int64_t, 5> tet_samples = samples_per_tet(L);
   const bool with_viscera = opt.model == MeshModel::WallViscera;
 
-  auto in_roi = [&](int64_t a, int64_t b, int64_t c) {
-    if (!opt.roi_min_mm || !opt.roi_max_mm) return true;
-    const Vec3 centre = g.to_world(Vec3((a + 0.5) * L - 0.5, (b + 0.5) * L - 0.5, (c + 0.5) * L - 0.5));
-    return (centre.array() >= opt.roi_min_mm->array()).all() && (centre.array() <= opt.roi_max_mm->array()).all();
-  };
-  // Which parts mesh each cube: those with a voxel of their role in it.
-  std::vector<uint8_t> meshed(content.size(), 0);   // bit p: part p meshes the cube
-  for (int64_t c = 0; c < lat.cubes[2]; ++c)
-    for (int64_t b = 0; b < lat.cubes[1]; ++b)
-      for (int64_t a = 0; a < lat.cubes[0]; ++a) {
-        const int64_t q = lat.cube_index(a, b, c);
-        if (!in_roi(a, b, c)) continue;
-        if (content[q].has[int(Role::Wall)]) meshed[q] |= 1;
-        if (with_viscera && content[q].has[int(Role::Viscera)]) meshed[q] |= 2;
-      }
+  const std::vector<uint8_t> meshed = meshed_parts(roles, lat, opt);
 
   Mesh m;
   m.grid = g;

@@ -33,12 +33,17 @@ RoleVolume load_roles(const Scene& scene) {
   return assign_roles(scene, ct, &labels);
 }
 
-Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene) {
+Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene, bool to_solve) {
   MeshOptions opt;
   opt.cube_voxels = cube_voxels_for(scene.mesh, roles.geometry);
   opt.model = scene.mesh.model;
   opt.roi_min_mm = scene.mesh.roi_min_mm;
   opt.roi_max_mm = scene.mesh.roi_max_mm;
+  if (to_solve) {
+    const SolveFootprint solver = solve_host_footprint(solve_options_from_scene(scene));
+    opt.reserve_bytes_per_node = solver.per_node;
+    opt.reserve_bytes_per_tet = solver.per_tet;
+  }
   Mesh m = build_mesh(roles, opt,
                       VoxelYoungFn([&](Role r, int label, float hu) { return scene.young_kpa_for(r, label, hu) * 1e3; }));
   m.tet_poisson.resize(m.tets.size());

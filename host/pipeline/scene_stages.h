@@ -16,8 +16,9 @@ RoleVolume assign_roles(const Scene& scene, const Volume& ct, const Volume* labe
 RoleVolume load_roles(const Scene& scene);
 
 /// The mesh of a case: mesh.* (the cube size from the CT's spacing when mesh.cube_mm is set),
-/// material.* per role, label and HU (Scene::young_kpa_for, poisson_for), masses and springs.
-Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene);
+/// material.* per role, label and HU (Scene::young_kpa_for, poisson_for), masses and springs. With
+/// `to_solve` the memory estimate checked before building counts the solver's state too.
+Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene, bool to_solve = false);
 
 /// The options a scene asks for (units converted to SI).
 SolveOptions solve_options_from_scene(const Scene& scene);

@@ -47,7 +47,7 @@ Simulation prepare_simulation(const Scene& scene) {
   sim.stage_seconds_roles = seconds_since(t0);
 
   t0 = std::chrono::steady_clock::now();
-  sim.mesh = build_scene_mesh(VoxelRoles{sim.roles.geometry, sim.roles.role.data(), sim.roles.label.data(), sim.roles.hu()}, scene);
+  sim.mesh = build_scene_mesh(VoxelRoles{sim.roles.geometry, sim.roles.role.data(), sim.roles.label.data(), sim.roles.hu()}, scene, /*to_solve=*/true);
   sim.stage_seconds_mesh = seconds_since(t0);
   const MeshStats& s = sim.mesh.stats;
   std::ostringstream os;

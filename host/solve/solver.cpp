@@ -52,6 +52,11 @@ double ramp_factor(double t_s, double ramp_s, RampShape shape) {
   return shape == RampShape::Linear ? tau : 0.5 * (1.0 - std::cos(M_PI * tau));
 }
 
+SolveFootprint solve_host_footprint(const SolveOptions& opt) {
+  const bool elements = opt.forces.material != MaterialModel::Msd;
+  return SolveFootprint{640, elements ? 640u : 64u};
+}
+
 SolveResult solve(const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x_start) {
   std::vector<Vec3> x = x_start.empty() ? m.rest_m : x_start;
   if (opt.forces.contact_stiffness > 0.0 && !solves_force_fields(opt.method))

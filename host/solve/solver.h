@@ -53,6 +53,16 @@ struct SolveOptions {
   bool progress = true;
 };
 
+/// Host memory a solve allocates beside its mesh, per node and per tetrahedron: an allowance for the
+/// largest scheme (Newton: positions, trial, forces and direction, CG's four vectors, the diagonal
+/// blocks and their inverses: about 12 Vec3 and 2 Mat3 a node, rounded up to 640 B), and for the
+/// elements' states (F, R, Ω⁻¹, F⁻ᵀ, δF, rest, Lamé: about 620 B a tetrahedron) or the springs'
+/// per-tetrahedron share. Checked with the mesh before either is built (mesh.h, MeshOptions).
+struct SolveFootprint {
+  uint64_t per_node = 0, per_tet = 0;
+};
+SolveFootprint solve_host_footprint(const SolveOptions& opt);
+
 struct SolveSample {              // one row of the convergence history
   int64_t step = 0;
   double time_s = 0, pressure_pa = 0, residual = 0, max_displacement_m = 0, max_speed_m_s = 0;
