@@ -1,6 +1,7 @@
 // Writes the fuzzers' seed corpora: small valid volumes of every voxel type in every format pneumo
 // reads (so the fuzzers start from files that pass every header check and mutate from there), and
-// the scenes shipped in scenes/. Usage: make_seeds SOURCE_DIR OUT_DIR; OUT_DIR/{nifti,metaimage,scene}.
+// the scenes shipped in scenes/; and the hostile headers of tests/hostile_headers.h, so mutation
+// starts at the size checks too. Usage: make_seeds SOURCE_DIR OUT_DIR; OUT_DIR/{nifti,metaimage,scene}.
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -8,6 +9,7 @@
 #include <random>
 #include <string>
 
+#include "../hostile_headers.h"
 #include "io/volume_io.h"
 #include "scene/scene.h"
 
@@ -39,6 +41,11 @@ int main(int argc, char** argv) {
     write_volume(v, (out / "nifti" / (stem + ".nii.gz")).string());
     write_volume(v, (out / "metaimage" / (stem + ".mha")).string());
     write_volume(v, (out / "metaimage" / (stem + "_z.mha")).string(), WriteOptions{true});
+  }
+  for (const hostile::HostileFile& f : hostile::hostile_files()) {
+    if (!f.data_file_name.empty()) continue;   // the fuzzers read one file
+    const bool nifti = f.name.find(".nii") != std::string::npos;
+    std::ofstream(out / (nifti ? "nifti" : "metaimage") / ("hostile_" + f.name), std::ios::binary) << f.bytes;
   }
   for (const auto& e : fs::directory_iterator(source / "scenes"))
     if (e.path().extension() == ".json")
