@@ -15,6 +15,7 @@
 #include "cl/cl_runtime.h"
 #include "mesh/deformation_file.h"
 #include "mesh/vtu_writer.h"
+#include "pipeline/cavity_measures.h"
 #include "pipeline/scene_stages.h"
 #include "report/plot_svg.h"
 #include "solve/gravity_compensation.h"
@@ -220,6 +221,7 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   j["anterior_rise_mm"] = d.anterior_rise_mm;
   j["mean_viscera_displacement_mm"] = d.mean_viscera_displacement_mm;
   j["mean_viscera_anterior_displacement_mm"] = d.mean_viscera_anterior_mm;
+  j["anterior_viscera_posterior_motion_mm"] = mean_posterior_motion_of_anterior_viscera_mm(sim.mesh, r.x);
   j["max_fixed_displacement_mm"] = d.max_fixed_displacement_mm;
   j["cavity_volume_ml"] = d.cavity_volume_ml;
   j["inverted_tetrahedra"] = r.inverted_tetrahedra;

@@ -13,6 +13,7 @@
 #include "core/units.h"
 #include "io/volume_io.h"
 #include "image/png.h"
+#include "pipeline/cavity_measures.h"
 #include "pipeline/scene_stages.h"
 #include "report/slices.h"
 #include "roles/connected_components.h"
@@ -221,6 +222,13 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
                                  {"below_ml", scene.output.min_cavity_piece_ml}};
     j["cavity_outside_largest_piece_fraction"] =
         w.cavity_voxels() > 0 ? 1.0 - double(largest) / double(w.cavity_voxels()) : 0.0;
+    // Gas in front of the extraperitoneal organs the roles keep attached (the bladder: the space of
+    // Retzius), in the deformed frame.
+    if (!scene.roles.auto_prevesical_labels.empty())
+      j["gas_anterior_to_prevesical_labels_ml"] =
+          double(gas_voxels_anterior_to(w.result.labels, w.output_grid, uint16_t(scene.output.cavity_label),
+                                        scene.roles.auto_prevesical_labels)) *
+          w.voxel_volume_ml;
   }
   j["warp"] = {{"device", w.result.device},
                {"cavity_label", scene.output.cavity_label},

@@ -1,0 +1,49 @@
+#include "pipeline/cavity_measures.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "roles/anatomical_axes.h"
+
+namespace pneumo {
+
+int64_t gas_voxels_anterior_to(const std::vector<uint16_t>& labels, const Geometry& g, uint16_t gas_label,
+                               const std::vector<int>& ids) {
+  std::vector<uint8_t> listed(65536, 0);
+  for (int id : ids)
+    if (id >= 0 && id < 65536) listed[std::size_t(id)] = 1;
+  const SliceFrame f = slice_frame(g);
+  int64_t count = 0;
+  for (int64_t s = 0; s < f.n_si; ++s)
+    for (int64_t l = 0; l < f.n_lat; ++l) {
+      // The most anterior listed voxel of the column, in "anteriority" (larger = more anterior).
+      int64_t front = -1;
+      for (int64_t a = 0; a < f.n_ap; ++a)
+        if (listed[labels[std::size_t(f.index(l, a, s))]]) front = std::max(front, f.ant(a));
+      if (front < 0) continue;
+      for (int64_t a = 0; a < f.n_ap; ++a)
+        if (f.ant(a) > front && labels[std::size_t(f.index(l, a, s))] == gas_label) ++count;
+    }
+  return count;
+}
+
+double mean_posterior_motion_of_anterior_viscera_mm(const Mesh& m, const std::vector<Vec3>& x) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int64_t n = 0; n < m.node_count(); ++n)
+    if (m.node_part[n] == Part::Viscera) {
+      lo = std::min(lo, m.rest_m[n].y());
+      hi = std::max(hi, m.rest_m[n].y());
+    }
+  if (!(hi >= lo)) return 0.0;
+  const double middle = 0.5 * (lo + hi);
+  double sum = 0.0;
+  int64_t count = 0;
+  for (int64_t n = 0; n < m.node_count(); ++n)
+    if (m.node_part[n] == Part::Viscera && m.rest_m[n].y() >= middle) {
+      sum += -(x[n].y() - m.rest_m[n].y()) * 1e3;   // m → mm, posterior positive
+      ++count;
+    }
+  return count ? sum / double(count) : 0.0;
+}
+
+}  // namespace pneumo

@@ -1,0 +1,69 @@
+// The fidelity measures of pipeline/cavity_measures.h against hand-counted cases: gas in front of
+// a listed organ in its own axial column only (whatever way the grid's axes run), and the viscera's
+// posterior motion over the anterior half of their extent only.
+#include <gtest/gtest.h>
+
+#include "pipeline/cavity_measures.h"
+
+namespace pneumo {
+namespace {
+
+constexpr uint16_t kGas = 250, kBladder = 21;
+
+/// A 3 × 8 × 2 grid (x lateral, y back to front, z slices) with the bladder at y = 3 in column
+/// (x = 1, z = 0), and gas at y = 1 (behind it), 5 and 6 (in front) in that column, plus gas at
+/// y = 6 in the columns without bladder.
+struct Column {
+  Geometry g;
+  std::vector<uint16_t> labels;
+  Column(const Mat3& direction) {
+    g.dims = {3, 8, 2};
+    g.direction = direction;
+    labels.assign(std::size_t(g.voxel_count()), 0);
+    auto at = [&](int i, int j, int k) -> uint16_t& { return labels[std::size_t(g.linear_index(i, j, k))]; };
+    // Index j along the grid's second axis; with a flipped axis, "in front" is lower j.
+    const bool flipped = direction(1, 1) < 0;
+    auto y = [&](int front_index) { return flipped ? 7 - front_index : front_index; };
+    at(1, y(3), 0) = kBladder;
+    at(1, y(1), 0) = kGas;
+    at(1, y(5), 0) = kGas;
+    at(1, y(6), 0) = kGas;
+    at(0, y(6), 0) = kGas;
+    at(1, y(6), 1) = kGas;   // next slice: no bladder there
+  }
+};
+
+TEST(CavityMeasures, GasInFrontOfTheBladderCountsOnlyInItsOwnColumn) {
+  const Column c(Mat3::Identity());
+  EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {kBladder}), 2);
+  EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {}), 0);
+  EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {99}), 0);
+}
+
+TEST(CavityMeasures, AGridStoredBackToFrontGivesTheSameCount) {
+  Mat3 lps = Mat3::Identity();
+  lps(0, 0) = -1;
+  lps(1, 1) = -1;   // LPS: index j increases posteriorly
+  const Column c(lps);
+  EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {kBladder}), 2);
+}
+
+TEST(CavityMeasures, PosteriorMotionIsAveragedOverTheAnteriorHalfOfTheViscera) {
+  Mesh m;
+  // Viscera nodes at y = 0, 10, 20, 30 mm; a wall node at 40 mm.
+  for (double y_mm : {0.0, 10.0, 20.0, 30.0}) {
+    m.rest_m.push_back(Vec3(0, y_mm * 1e-3, 0));
+    m.node_part.push_back(Part::Viscera);
+  }
+  m.rest_m.push_back(Vec3(0, 0.04, 0));
+  m.node_part.push_back(Part::Wall);
+  std::vector<Vec3> x = m.rest_m;
+  x[0].y() -= 0.100;   // the posterior half moves a lot: not counted
+  x[2].y() -= 0.004;   // 4 mm back
+  x[3].y() -= 0.002;   // 2 mm back
+  x[4].y() += 0.050;   // the wall rises: not counted
+  EXPECT_NEAR(mean_posterior_motion_of_anterior_viscera_mm(m, x), 3.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace pneumo
