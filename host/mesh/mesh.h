@@ -58,6 +58,10 @@ struct MeshOptions {
   /// What the caller will allocate per node and per tetrahedron once the mesh exists (a solver's
   /// state), counted in the memory estimate build_mesh checks before it allocates anything.
   uint64_t reserve_bytes_per_node = 0, reserve_bytes_per_tet = 0;
+  /// Wall labels whose interface with the viscera stays closed (the retroperitoneal and
+  /// extraperitoneal organs the viscera lie on): no gas pressure on those voxel faces, and their
+  /// nodes marked in Mesh::node_attached for the bond of solve/interface_tie.h.
+  std::vector<int> attached_labels;
 };
 
 struct Mesh;
@@ -99,6 +103,7 @@ struct ContactFaces {
 struct MeshStats {
   int64_t nodes = 0, tetrahedra = 0, springs = 0, fixed_nodes = 0;
   int64_t cavity_faces = 0;        // voxel faces between wall and viscera, both sides counted
+  int64_t attached_faces = 0;      // of those, the ones of an attached label (no gas), both sides
   int64_t pressure_tetrahedra = 0; // tetrahedra carrying some of them
   int64_t wall_cubes = 0, viscera_cubes = 0, doubled_cubes = 0;
   int64_t wall_nodes = 0, viscera_nodes = 0;
@@ -110,6 +115,7 @@ struct Mesh {
   std::vector<Part> node_part;
   std::vector<uint8_t> hold;                // kHold* mask
   std::vector<std::array<int32_t, 3>> node_lattice;   // lattice coordinates (cube corners)
+  std::vector<uint8_t> node_attached;       // 1: a corner of a cube holding an attached face (MeshOptions)
   std::vector<double> mass_kg;              // §4: ρ Σ V_t / 4 (set by assign_material)
 
   // Tetrahedra (positively oriented at rest).

@@ -162,12 +162,63 @@ std::array<double, 3> cube_local(const Vec3& index, int64_t a, int64_t b, int64_
           (index[2] + 0.5 - double(c * L)) / L};
 }
 
+/// The wall labels of MeshOptions::attached_labels, looked up per voxel.
+struct AttachedLabels {
+  std::vector<uint8_t> listed;   // by label id; empty: none
+  explicit AttachedLabels(const std::vector<int>& ids) {
+    for (int id : ids) {
+      if (id < 0 || id > 65535) continue;
+      if (listed.empty()) listed.assign(65536, 0);
+      listed[std::size_t(id)] = 1;
+    }
+  }
+  /// Whether wall voxel v carries an attached label.
+  bool holds(const VoxelRoles& roles, int64_t v) const {
+    return !listed.empty() && roles.label && listed[roles.label[v]] != 0;
+  }
+};
+
+/// Marks the nodes of attached interfaces (Mesh::node_attached): for every face between a wall voxel
+/// of an attached label and a viscera voxel, the corners of the wall voxel's cube in the wall's mesh
+/// and of the viscera voxel's cube in the viscera's. Counts those faces, both sides, as the cavity's.
+void mark_attached_nodes(Mesh& m, const VoxelRoles& roles, int L, const std::vector<int32_t> (&node_id)[kParts],
+                         const Lattice& lat, const AttachedLabels& attached) {
+  m.node_attached.assign(std::size_t(m.node_count()), 0);
+  if (attached.listed.empty()) return;
+  const Geometry& g = roles.geometry;
+  auto mark_cube = [&](int p, int64_t i, int64_t j, int64_t k) {
+    const int64_t a = i / L, b = j / L, c = k / L;
+    for (int corner = 0; corner < 8; ++corner) {
+      const auto o = lattice::corner_offset(corner);
+      const int32_t id = node_id[p][lat.node_index(a + o[0], b + o[1], c + o[2])];
+      if (id >= 0) m.node_attached[id] = 1;
+    }
+  };
+  for (int64_t k = 0; k < g.dims[2]; ++k)
+    for (int64_t j = 0; j < g.dims[1]; ++j)
+      for (int64_t i = 0; i < g.dims[0]; ++i) {
+        const int64_t v = g.linear_index(i, j, k);
+        if (roles.role[v] != Role::Wall || !attached.holds(roles, v)) continue;
+        for (int axis = 0; axis < 3; ++axis)
+          for (int side = -1; side <= 1; side += 2) {
+            int64_t n[3] = {i, j, k};
+            n[axis] += side;
+            if (n[axis] < 0 || n[axis] >= g.dims[axis]) continue;
+            if (roles.role[g.linear_index(n[0], n[1], n[2])] != Role::Viscera) continue;
+            mark_cube(0, i, j, k);
+            mark_cube(1, n[0], n[1], n[2]);
+            m.stats.attached_faces += 2;
+          }
+      }
+}
+
 /// The pressure loads (mesh.h): every voxel face between a voxel of part p and one of the other
 /// part's role, split into 4 triangles (centre and each edge) so each lies in one tetrahedron face
 /// when L = 1, carried by part p's tetrahedron in the voxel's cube that holds the triangle's centroid.
 /// The same faces make the contact surfaces between wall and viscera (mesh.h).
 void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, int L,
-                          const std::vector<uint8_t>& meshed, const std::vector<int32_t> (&first_tet)[kParts]) {
+                          const std::vector<uint8_t>& meshed, const std::vector<int32_t> (&first_tet)[kParts],
+                          const AttachedLabels& attached) {
   const Geometry& g = roles.geometry;
   struct Accum {
     int32_t tet;
@@ -204,8 +255,11 @@ void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
                   // The viscera's whole surface is the contact's slave side (solve/contact.h); the
                   // wall's faces towards viscera are its master side and, with the viscera's towards
                   // the wall, the cavity's.
-                  const Role beyond = roles.role[g.linear_index(n[0], n[1], n[2])];
-                  const bool cavity = beyond == other;
+                  const int64_t nv = g.linear_index(n[0], n[1], n[2]);
+                  const Role beyond = roles.role[nv];
+                  // An attached organ's face towards the viscera stays closed: no gas, no pressure.
+                  const bool cavity =
+                      beyond == other && !attached.holds(roles, p == 0 ? g.linear_index(i, j, k) : nv);
                   if (!cavity && !(p == 1 && beyond != Role::Viscera)) continue;
                   const VoxelFace face = voxel_face(g, i, j, k, axis, side);
                   {
@@ -404,7 +458,8 @@ MeshFootprint estimate_mesh_footprint(const VoxelRoles& roles, const MeshOptions
                                 sizeof(std::array<int32_t, 6>)) +
                            6 * sizeof(std::pair<int64_t, int64_t>);   // the edge sort, reserved exactly
   const uint64_t per_node =
-      2 * (sizeof(Vec3) + sizeof(Part) + sizeof(uint8_t) + sizeof(std::array<int32_t, 3>) + sizeof(double));
+      2 * (sizeof(Vec3) + sizeof(Part) + sizeof(uint8_t) + sizeof(std::array<int32_t, 3>) + sizeof(double)) +
+      sizeof(uint8_t);   // node_attached, sized once
   const uint64_t per_spring = 2 * (sizeof(std::array<int32_t, 2>) + 3 * sizeof(double));
   const uint64_t per_contact_face = 4 * (sizeof(int32_t) + sizeof(std::array<double, 4>) + sizeof(Vec3) + sizeof(Part));
   const uint64_t per_load = 2 * (sizeof(int32_t) + 2 * sizeof(std::array<Vec3, 4>) + sizeof(int64_t));
@@ -439,7 +494,7 @@ void require_mesh_memory(const VoxelRoles& roles, const MeshOptions& opt) {
 uint64_t mesh_bytes(const Mesh& m) {
   auto held = [](const auto& v) { return uint64_t(v.capacity()) * sizeof(v[0]); };
   const ContactFaces& c = m.contact;
-  return held(m.rest_m) + held(m.node_part) + held(m.hold) + held(m.node_lattice) + held(m.mass_kg) + held(m.tets) +
+  return held(m.rest_m) + held(m.node_part) + held(m.hold) + held(m.node_lattice) + held(m.node_attached) + held(m.mass_kg) + held(m.tets) +
          held(m.tet_part) + held(m.tet_label) + held(m.tet_fraction) + held(m.tet_cube) + held(m.tet_rest_volume_m3) +
          held(m.tet_young_pa) + held(m.tet_poisson) + held(m.tet_springs) + held(m.springs) + held(m.spring_rest_m) +
          held(m.spring_k) + held(m.spring_c) + held(m.load_tet) + held(m.load_c) + held(c.tet) + held(c.w) + held(c.c) +
@@ -545,7 +600,9 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
           if (node_id[p][ni] >= 0) m.hold[node_id[p][ni]] = kHoldAll;
       }
 
-  build_pressure_loads(m, roles, lat, L, meshed, first_tet);
+  const AttachedLabels attached(opt.attached_labels);
+  build_pressure_loads(m, roles, lat, L, meshed, first_tet, attached);
+  mark_attached_nodes(m, roles, L, node_id, lat, attached);
   if (with_viscera) build_bone_obstacles(m, roles, lat, L, meshed);
 
   // Springs: unique tetrahedron edges (per part: parts never share nodes).

@@ -39,6 +39,7 @@ Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene, bool to_solve
   opt.model = scene.mesh.model;
   opt.roi_min_mm = scene.mesh.roi_min_mm;
   opt.roi_max_mm = scene.mesh.roi_max_mm;
+  opt.attached_labels = scene.mesh.attached_labels;
   if (to_solve) {
     const SolveFootprint solver = solve_host_footprint(solve_options_from_scene(scene));
     opt.reserve_bytes_per_node = solver.per_node;
@@ -70,6 +71,7 @@ SolveOptions solve_options_from_scene(const Scene& s) {
   const double tilt = s.material.tilt_deg * (3.14159265358979323846 / 180.0);
   if (s.material.gravity) o.forces.gravity_m_s2 = 9.81 * Vec3(0, -std::cos(tilt), std::sin(tilt));
   if (s.material.contact) o.forces.contact_stiffness = s.material.contact_stiffness;
+  o.forces.tie_attached = !s.mesh.attached_labels.empty();
   o.dt_s = units::ms_to_s(s.solver.dt_ms);
   o.dt_safety = s.solver.dt_safety;
   o.max_steps = s.solver.max_steps;

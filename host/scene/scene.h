@@ -34,6 +34,7 @@ struct SceneMesh {
   std::optional<double> cube_mm;  // when set, L from the CT's spacing (cube_voxels_for)
   MeshModel model = MeshModel::WallViscera;
   std::optional<Vec3> roi_min_mm, roi_max_mm;  // both or neither
+  std::vector<int> attached_labels;   // wall labels whose interface with the viscera stays closed
 };
 
 /// Young's modulus for one label id, overriding the role's value.

@@ -143,6 +143,11 @@ const Table<SceneMesh>& mesh_table() {
       {"roi_min_mm", &SceneMesh::roi_min_mm, "mm", any(),
        "Lower corner (world RAS+) of the box meshed; with roi_max_mm, both or neither. Unset: the whole volume."},
       {"roi_max_mm", &SceneMesh::roi_max_mm, "mm", any(), "Upper corner of the box meshed; each coordinate > roi_min_mm's."},
+      {"attached_labels", &SceneMesh::attached_labels, "", in(0, kMaxLabel),
+       "Wall labels the viscera stay on (retroperitoneal and extraperitoneal organs): no gas opens between them "
+       "and the viscera, which are bonded to them there (solve/interface_tie.h). Needs solver.method \"static\", "
+       "\"newton\" or \"implicit-euler\". TotalSegmentator: the example scene's wall_labels. Empty: every "
+       "wall-viscera interface may open."},
   };
   return t;
 }

@@ -64,6 +64,10 @@ void check_material_model(const Scene& s, const At& root) {
     root.child("solver").child("method").fail_value(enum_name(s.solver.method),
                                                     "cannot solve with material.contact; use \"newton\", \"static\" "
                                                     "or \"implicit-euler\", or set contact to false");
+  if (!s.mesh.attached_labels.empty() && !solves_force_fields(s.solver.method))
+    root.child("solver").child("method").fail_value(enum_name(s.solver.method),
+                                                    "cannot solve with mesh.attached_labels; use \"newton\", \"static\" "
+                                                    "or \"implicit-euler\", or leave attached_labels empty");
   if (m.tilt_deg != 0.0 && !m.gravity)
     root.child("material").child("tilt_deg").fail_value(m.tilt_deg, "tilts gravity, which is off: set gravity to true");
   if (m.model == MaterialModel::Msd) return;

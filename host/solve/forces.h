@@ -19,6 +19,7 @@ struct ForceModel {
   Vec3 gravity_m_s2 = Vec3::Zero();    // option (Bano); zero = off
   double contact_stiffness = 0.0;      // κ of the viscera's contact with wall and bone (contact.h); 0 = off
   bool tie_interface = false;          // wall bonded to viscera where they touch at rest (interface_tie.h)
+  bool tie_attached = false;           // ... only at the attached interfaces (Mesh::node_attached)
   double stiffening = 0.0;             // b of the exponential spring law (stiffened_strain), or of
                                        // Demiray's law for fem-neohookean; 0 = linear / neo-Hookean
 };

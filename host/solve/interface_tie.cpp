@@ -74,7 +74,7 @@ class TiedForceField final : public ForceField {
 
 }  // namespace
 
-std::vector<TiedPair> interface_pairs(const Mesh& m) {
+std::vector<TiedPair> interface_pairs(const Mesh& m, bool attached_only) {
   std::vector<double> node_k(m.node_count(), 0.0);
   for (std::size_t t = 0; t < m.tets.size(); ++t) {
     const double k = lloyd_tet_spring_k(m.tet_young_pa[t], m.tet_rest_volume_m3[t]);
@@ -89,14 +89,15 @@ std::vector<TiedPair> interface_pairs(const Mesh& m) {
   for (std::size_t i = 0; i + 1 < order.size(); ++i) {
     const int32_t a = order[i], b = order[i + 1];
     if (m.node_lattice[a] != m.node_lattice[b] || m.node_part[a] != Part::Wall || m.node_part[b] != Part::Viscera) continue;
+    if (attached_only && (m.node_attached.empty() || !m.node_attached[a] || !m.node_attached[b])) continue;
     pairs.push_back({a, b, kTieKappa * std::max(node_k[a], node_k[b])});
   }
   return pairs;
 }
 
 std::unique_ptr<ForceField> with_interface_tie(const Mesh& m, const ForceModel& model, std::unique_ptr<ForceField> inner) {
-  if (!model.tie_interface) return inner;
-  std::vector<TiedPair> pairs = interface_pairs(m);
+  if (!model.tie_interface && !model.tie_attached) return inner;
+  std::vector<TiedPair> pairs = interface_pairs(m, !model.tie_interface);
   if (pairs.empty()) return inner;
   return std::make_unique<TiedForceField>(m, std::move(pairs), std::move(inner));
 }

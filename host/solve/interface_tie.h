@@ -10,6 +10,10 @@
 // times the stiffer node's own spring stiffness (Σ over its tetrahedra of Lloyd's k for their modulus
 // and volume, mesh.h), so the pair slips by a tenth of what the tissue next to it deforms under the
 // same force.
+//
+// The same bond holds for good where the viscera lie on an organ the scene lists as attached
+// (MeshOptions::attached_labels): there the gas does not open, so the gas in front pushes the
+// viscera back against it, as the bowel moves dorsally in patients, instead of floating them in gas.
 #include <memory>
 #include <vector>
 
@@ -25,10 +29,13 @@ struct TiedPair {
   double stiffness_n_per_m = 0;
 };
 
-/// The coincident wall/viscera node pairs of m and their bond stiffness.
-std::vector<TiedPair> interface_pairs(const Mesh& m);
+/// The coincident wall/viscera node pairs of m and their bond stiffness; with `attached_only`, the
+/// pairs whose nodes are both marked in m.node_attached.
+std::vector<TiedPair> interface_pairs(const Mesh& m, bool attached_only = false);
 
-/// `inner` with the bond added when model.tie_interface is set and m has pairs; `inner` otherwise.
+/// `inner` with the bond added when model.tie_interface is set (every pair) or model.tie_attached
+/// (the attached interfaces' pairs: retroperitoneal organs the viscera stay on, MeshOptions) and m
+/// has such pairs; `inner` otherwise.
 std::unique_ptr<ForceField> with_interface_tie(const Mesh& m, const ForceModel& model, std::unique_ptr<ForceField> inner);
 
 }  // namespace pneumo

@@ -15,7 +15,7 @@ bool device_implements(const SolveOptions& opt) {
   const bool fem = opt.forces.material != MaterialModel::Msd;
   if (opt.method == SolverMethod::ImplicitEuler) return false;
   // The springs' device schemes have no contact and no interface bond.
-  if ((opt.forces.contact_stiffness > 0.0 || opt.forces.tie_interface) && !fem) return false;
+  if ((opt.forces.contact_stiffness > 0.0 || opt.forces.tie_interface || opt.forces.tie_attached) && !fem) return false;
   return opt.method == SolverMethod::Newton ? fem : !fem;
 }
 

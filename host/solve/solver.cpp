@@ -59,6 +59,9 @@ SolveFootprint solve_host_footprint(const SolveOptions& opt) {
 
 SolveResult solve(const Mesh& m, const SolveOptions& opt, const std::vector<Vec3>& x_start) {
   std::vector<Vec3> x = x_start.empty() ? m.rest_m : x_start;
+  if (opt.forces.tie_attached && !solves_force_fields(opt.method))
+    throw InputError(std::string("mesh.attached_labels needs solver.method \"static\", \"newton\" or \"implicit-euler\", not \"") +
+                     enum_name(opt.method) + "\"");
   if (opt.forces.contact_stiffness > 0.0 && !solves_force_fields(opt.method))
     throw InputError(std::string("contact needs solver.method \"static\", \"newton\" or \"implicit-euler\", not \"") +
                      enum_name(opt.method) + "\"");
