@@ -8,12 +8,16 @@
 #include <nifti1.h>
 #include <zlib.h>
 
+#include <algorithm>
+
 #include <array>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
+
+#include "nifti_test_header.h"
 
 namespace pneumo::hostile {
 
@@ -72,22 +76,11 @@ inline std::string gzip(const std::string& data) {
 }
 
 inline std::string nifti1_bytes(const std::array<int64_t, 3>& d, const HostileType& t) {
-  nifti_1_header h;
-  std::memset(&h, 0, sizeof h);
-  h.sizeof_hdr = 348;
-  h.dim[0] = 3;
-  for (int a = 0; a < 3; ++a)
-    h.dim[a + 1] = short(std::max<int64_t>(std::numeric_limits<short>::min(), std::min<int64_t>(d[a], 32767)));
-  for (int i = 4; i < 8; ++i) h.dim[i] = 1;
-  h.datatype = t.nifti_code;
-  h.bitpix = t.bits;
-  for (int i = 0; i < 8; ++i) h.pixdim[i] = 1.0f;
-  h.vox_offset = 352.0f;
-  h.scl_slope = 1.0f;
-  h.xyzt_units = NIFTI_UNITS_MM;
-  h.sform_code = NIFTI_XFORM_SCANNER_ANAT;
-  h.srow_x[0] = h.srow_y[1] = h.srow_z[2] = 1.0f;
-  std::memcpy(h.magic, "n+1\0", 4);
+  auto clamp16 = [](int64_t v) {
+    return int(std::max<int64_t>(std::numeric_limits<short>::min(), std::min<int64_t>(v, 32767)));
+  };
+  const nifti_1_header h =
+      testing_support::nifti1_test_header(clamp16(d[0]), clamp16(d[1]), clamp16(d[2]), t.nifti_code, t.bits);
   return std::string(reinterpret_cast<const char*>(&h), sizeof h) + std::string(4, '\0') + small_payload();
 }
 

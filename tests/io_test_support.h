@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "nifti_test_header.h"
+
 namespace pneumo::testing_support {
 
 /// A fresh, empty folder under the test temp dir, unique per test and process; removed at the end.

@@ -84,24 +84,7 @@ std::string meta_file(const ScratchDir& dir, const std::string& name, const Meta
 // ---- NIfTI -------------------------------------------------------------------------------------
 
 nifti_1_header nifti_header(int nx, int ny, int nz, short datatype, short bitpix) {
-  nifti_1_header h;
-  std::memset(&h, 0, sizeof h);
-  h.sizeof_hdr = 348;
-  h.dim[0] = 3;
-  h.dim[1] = static_cast<short>(nx);
-  h.dim[2] = static_cast<short>(ny);
-  h.dim[3] = static_cast<short>(nz);
-  for (int i = 4; i < 8; ++i) h.dim[i] = 1;
-  h.datatype = datatype;
-  h.bitpix = bitpix;
-  for (int i = 0; i < 8; ++i) h.pixdim[i] = 1.0f;
-  h.vox_offset = 352.0f;
-  h.scl_slope = 1.0f;
-  h.xyzt_units = NIFTI_UNITS_MM;
-  h.sform_code = NIFTI_XFORM_SCANNER_ANAT;
-  h.srow_x[0] = h.srow_y[1] = h.srow_z[2] = 1.0f;
-  std::memcpy(h.magic, "n+1\0", 4);
-  return h;
+  return testing_support::nifti1_test_header(nx, ny, nz, datatype, bitpix);
 }
 
 nifti_1_header good_nifti_header() { return nifti_header(10, 10, 10, DT_INT16, 16); }

@@ -172,20 +172,7 @@ TEST(IoRoundtrip, MetaImageGeometryIsExactForAwkwardNumbers) {
 
 TEST(IoRoundtrip, NiftiWithIdentityAffineIsRAS) {
   ScratchDir dir;
-  nifti_1_header h{};
-  h.sizeof_hdr = 348;
-  h.dim[0] = 3;
-  h.dim[1] = 2; h.dim[2] = 3; h.dim[3] = 4;
-  for (int i = 4; i < 8; ++i) h.dim[i] = 1;
-  h.datatype = DT_UINT8;
-  h.bitpix = 8;
-  for (int i = 0; i < 8; ++i) h.pixdim[i] = 1.0f;
-  h.vox_offset = 352.0f;
-  h.scl_slope = 1.0f;
-  h.xyzt_units = NIFTI_UNITS_MM;
-  h.sform_code = NIFTI_XFORM_SCANNER_ANAT;
-  h.srow_x[0] = h.srow_y[1] = h.srow_z[2] = 1.0f;
-  std::memcpy(h.magic, "n+1\0", 4);
+  const nifti_1_header h = testing_support::nifti1_test_header(2, 3, 4, DT_UINT8, 8);
   std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
   bytes += std::string(4, '\0') + std::string(2 * 3 * 4, '\x07');
   const std::string path = dir.file("identity.nii");
