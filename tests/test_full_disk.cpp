@@ -5,7 +5,10 @@
 // EFBIG as on a full disk), which needs no mount and cannot touch anything else.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <string>
 
@@ -49,6 +52,40 @@ TEST(FullDisk, AWarpThatCannotWriteItsCtLeavesNoFileUnderItsNameAndSaysWhich) {
   const CliResult ok = run_pneumo("-q warp " + scene + " --out " + d.file("out"));
   ASSERT_EQ(ok.code, 0) << ok.err;
   EXPECT_TRUE(fs::exists(d.file("out/deformed_ct.nii.gz")));
+}
+
+/// Bytes of `dir/name`.
+uint64_t file_bytes(const ScratchDir& d, const std::string& name) { return fs::file_size(d.file(name)); }
+
+// A warp writes three images, then metrics.json. When the last image fails, the first two
+// (written whole) are removed too: they would otherwise look like a finished warp's, and the next
+// `pneumo warp` refused them as "already holds a warp".
+TEST(FullDisk, AWarpThatFailsAfterItsFirstImagesRemovesThemAndCanBeRunAgain) {
+  ScratchDir d;
+  const std::string scene = write_tiny_case(d, tiny_case_scene_json(), tiny_case_ct());
+  ASSERT_EQ(run_pneumo("-q simulate " + scene + " --out " + d.file("out")).code, 0);
+  ASSERT_EQ(run_pneumo("-q simulate " + scene + " --out " + d.file("probe")).code, 0);
+  ASSERT_EQ(run_pneumo("-q warp " + scene + " --out " + d.file("probe")).code, 0);
+  // A per-file limit that the two NIfTIs fit under and the slices PNG does not.
+  const uint64_t largest_nifti = std::max(file_bytes(d, "probe/deformed_ct.nii.gz"), file_bytes(d, "probe/deformed_labels.nii.gz"));
+  const int kib = int(largest_nifti / 1024 + 2);
+  ASSERT_GT(file_bytes(d, "probe/slices_before_after.png"), uint64_t(kib) * 1024) << "the case no longer separates them";
+  const std::string metrics_before = slurp(d.file("out/metrics.json"));
+  const auto before = tree(d.path() / "out");
+  const CliResult r = run_pneumo_with_file_limit(kib, "-q warp " + scene + " --out " + d.file("out"));
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("slices_before_after.png"), std::string::npos) << r.err;
+  EXPECT_EQ(tree(d.path() / "out"), before) << "the images written before the failure stayed";
+  EXPECT_EQ(slurp(d.file("out/metrics.json")), metrics_before);
+  const CliResult again = run_pneumo("-q warp " + scene + " --out " + d.file("out"));
+  ASSERT_EQ(again.code, 0) << "a failed warp blocked the next one: " << again.err;
+
+  // Replacing a finished warp (--force) that fails leaves no warp, not the old metrics over new images.
+  const CliResult forced = run_pneumo_with_file_limit(kib, "-q warp " + scene + " --out " + d.file("out") + " --force");
+  EXPECT_EQ(forced.code, 1) << forced.err;
+  EXPECT_FALSE(fs::exists(d.file("out/deformed_ct.nii.gz")));
+  EXPECT_FALSE(nlohmann::json::parse(slurp(d.file("out/metrics.json"))).contains("warp")) << "still marked as warped";
+  EXPECT_EQ(run_pneumo("-q warp " + scene + " --out " + d.file("out")).code, 0);
 }
 
 }  // namespace

@@ -37,8 +37,9 @@ Run add_warp(CLI::App& app) {
     ocl::parse_device_spec(scene.device);   // a bad --device is bad input before any work
     const OutputFolderLock lock(o->out);   // one pneumo at a time in --out (core/output_lock.h)
     const std::string metrics_path = (std::filesystem::path(o->out) / "metrics.json").string();
-    if (!o->force && (std::filesystem::exists(std::filesystem::path(o->out) / "deformed_ct.nii.gz") ||
-                      warp_metrics_present(metrics_path)))
+    // metrics.json is written last (write_warp), so its warp keys mark a warp that finished; images
+    // without them are what an interrupted warp left, replaced without --force.
+    if (!o->force && warp_metrics_present(metrics_path))
       throw InputError(o->out + ": already holds a warp; use --force to overwrite");
     // A read-only folder is refused before the warp's work (write_warp checks again before writing).
     if (std::filesystem::exists(metrics_path)) check_writable_target(metrics_path);

@@ -244,12 +244,38 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
   return j;
 }
 
+namespace {
+/// The files one warp writes are one result: each is written atomically, and if a later one fails
+/// the earlier ones are removed again, so a failed warp (a full disk) leaves no image that looks
+/// like a finished warp's. metrics.json's "warp" key, written last, marks the warp as finished.
+class WarpOutputs {
+ public:
+  explicit WarpOutputs(std::string dir) : dir_(std::move(dir)) {}
+  ~WarpOutputs() {
+    if (committed_) return;
+    std::error_code ec;
+    for (const std::string& p : written_) std::filesystem::remove(p, ec);
+  }
+  /// The path for `name`, recorded as this warp's (write it before the next call).
+  std::string add(const char* name) { return written_.emplace_back(in_dir(dir_, name)); }
+  void commit() { committed_ = true; }
+
+ private:
+  std::string dir_;
+  std::vector<std::string> written_;
+  bool committed_ = false;
+};
+}  // namespace
+
 void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir) {
   nlohmann::json metrics = read_metrics(dir);
   check_writable_target(in_dir(dir, "metrics.json"));
-  if (scene.output.write_deformed_ct) write_volume(deformed_ct_volume(w), in_dir(dir, "deformed_ct.nii.gz"));
+  // An earlier warp replaced (--force) stops counting as finished before its images are replaced.
+  if (metrics.erase("warp") > 0) write_text_file_atomic(in_dir(dir, "metrics.json"), metrics.dump(2) + "\n");
+  WarpOutputs outputs(dir);
+  if (scene.output.write_deformed_ct) write_volume(deformed_ct_volume(w), outputs.add("deformed_ct.nii.gz"));
   if (scene.output.write_deformed_labels && w.labels)
-    write_volume(deformed_label_volume(w, scene.output.cavity_label), in_dir(dir, "deformed_labels.nii.gz"));
+    write_volume(deformed_label_volume(w, scene.output.cavity_label), outputs.add("deformed_labels.nii.gz"));
   if (scene.output.write_slices) {
     const Volume after = deformed_ct_volume(w);
     std::vector<uint8_t> gas(w.result.outcome.size());
@@ -269,7 +295,7 @@ void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir)
     std::snprintf(title, sizeof title, "after, %.1f mmHg (cavity in blue)",
                   w.deformation.pressure_pa / units::kPaPerMmHg);
     view.title = title;
-    write_png(in_dir(dir, "slices_before_after.png"),
+    write_png(outputs.add("slices_before_after.png"),
               stack_rows({before, render_slice_row(after, &overlay, view), render_legend(overlay.table)}));
   }
   // The mesh's own estimate (from simulate) keeps a name of its own once the warp has counted voxels.
@@ -279,6 +305,7 @@ void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir)
   if (metrics.contains("stage_seconds") && metrics["stage_seconds"].is_object())
     metrics["stage_seconds"]["warp"] = w.seconds_warp;
   write_text_file_atomic(in_dir(dir, "metrics.json"), metrics.dump(2) + "\n");
+  outputs.commit();
 }
 
 }  // namespace pneumo
