@@ -19,11 +19,11 @@ packages=(
   libnifti2-dev zlib1g-dev
   # CLI and scenes
   libcli11-dev nlohmann-json3-dev
-  # tests and benchmarks
-  libgtest-dev googletest libbenchmark-dev
+  # tests and benchmarks; VTK's Python reader checks the meshes pneumo writes (tests/test_vtu_vtk.cpp)
+  libgtest-dev googletest libbenchmark-dev python3-vtk9 python3-numpy
 )
 if [ "${1:-}" = "--peers" ]; then
-  packages+=(python3-numpy python3-scipy python3-vtk9 libinsighttoolkit5-dev libglew-dev)
+  packages+=(python3-scipy libinsighttoolkit5-dev libglew-dev)
 fi
 
 SUDO=""
