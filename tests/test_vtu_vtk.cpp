@@ -44,5 +44,16 @@ TEST(VtuVtk, VtksReaderLoadsBothMeshesWithEveryArray) {
   EXPECT_LT(double(v["max_points_minus_rest_minus_displacement_mm"]), 1e-9);
 }
 
+TEST(VtuVtk, WriteMeshesFalseWritesNone) {
+  ScratchDir d;
+  nlohmann::json s = tiny_case_scene_json();
+  s["output"] = {{"write_meshes", false}};
+  const std::string scene = write_tiny_case(d, s);
+  ASSERT_EQ(run_pneumo("-q simulate " + scene + " --out " + d.file("out")).code, 0);
+  EXPECT_TRUE(fs::exists(d.file("out/metrics.json")));
+  EXPECT_FALSE(fs::exists(d.file("out/mesh_initial.vtu")));
+  EXPECT_FALSE(fs::exists(d.file("out/mesh_deformed.vtu")));
+}
+
 }  // namespace
 }  // namespace pneumo

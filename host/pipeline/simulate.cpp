@@ -294,8 +294,13 @@ std::string pressure_curve_plot_svg(const std::vector<PressurePoint>& curve) {
 void write_simulation(const Scene& scene, const Simulation& sim, const std::string& dir) {
   std::filesystem::create_directories(dir);
   const auto path = [&](const char* name) { return (std::filesystem::path(dir) / name).string(); };
-  write_vtu(sim.mesh, {}, path("mesh_initial.vtu"));
-  write_vtu(sim.mesh, sim.result.x, path("mesh_deformed.vtu"));
+  if (scene.output.write_meshes) {
+    write_vtu(sim.mesh, {}, path("mesh_initial.vtu"));
+    write_vtu(sim.mesh, sim.result.x, path("mesh_deformed.vtu"));
+  } else {
+    // An earlier (--force) simulation's meshes would not be this one's.
+    for (const char* name : {"mesh_initial.vtu", "mesh_deformed.vtu"}) std::filesystem::remove(path(name));
+  }
   std::ostringstream csv;
   csv << "step,time_s,pressure_mmhg,residual,max_displacement_mm,max_speed_mm_s\n";
   for (const auto& h : sim.result.history)

@@ -84,9 +84,10 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim);
 std::string convergence_plot_svg(const SolveResult& r);
 std::string pressure_curve_plot_svg(const std::vector<PressurePoint>& curve);
 
-/// Writes mesh_initial.vtu, mesh_deformed.vtu, convergence.csv/.svg, scene_used.json, with a
-/// pressure curve pressure_volume.csv/.svg, deformation.bin (the node displacements `pneumo warp`
-/// reads) and metrics.json (last) into `dir` (created if needed), each atomically.
+/// Writes mesh_initial.vtu and mesh_deformed.vtu (when output.write_meshes), convergence.csv/.svg,
+/// scene_used.json, with a pressure curve pressure_volume.csv/.svg, deformation.bin (the node
+/// displacements `pneumo warp` reads) and metrics.json (last) into `dir` (created if needed), each
+/// atomically.
 void write_simulation(const Scene& scene, const Simulation& sim, const std::string& dir);
 
 }  // namespace pneumo

@@ -103,7 +103,7 @@ struct SceneSolver {
 
 struct SceneOutput {
   std::string folder;             // "" = the command line decides
-  bool write_meshes = false;
+  bool write_meshes = true;      // mesh_initial.vtu and mesh_deformed.vtu (compressed; ParaView, VTK, meshio)
   bool write_deformed_ct = true;
   bool write_deformed_labels = true;
   OutputGrid grid = OutputGrid::Working;

@@ -389,7 +389,7 @@ const Table<ViewSettings>& render_table() {
 const Table<SceneOutput>& output_table() {
   static const Table<SceneOutput> t{
       {"folder", &SceneOutput::folder, "", file_path(), "Where outputs go; unset: the command line decides (--out)."},
-      {"write_meshes", &SceneOutput::write_meshes, "", any(), "Write the rest and deformed meshes (.vtu)."},
+      {"write_meshes", &SceneOutput::write_meshes, "", any(), "Write the rest and deformed meshes, mesh_initial.vtu and mesh_deformed.vtu (VTK XML, zlib-compressed: ParaView, VTK, meshio)."},
       {"write_deformed_ct", &SceneOutput::write_deformed_ct, "", any(), "Write the warped CT (§7)."},
       {"write_deformed_labels", &SceneOutput::write_deformed_labels, "", any(),
        "Write the warped label map (with the cavity label) when a label map is given (§7)."},
