@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/memory_budget.h"
 #include "core/units.h"
+#include "domain/label_set.h"
 #include "mesh/cube_lattice.h"
 #include "mesh/mesh.h"
 
@@ -164,18 +165,10 @@ std::array<double, 3> cube_local(const Vec3& index, int64_t a, int64_t b, int64_
 
 /// The wall labels of MeshOptions::attached_labels, looked up per voxel.
 struct AttachedLabels {
-  std::vector<uint8_t> listed;   // by label id; empty: none
-  explicit AttachedLabels(const std::vector<int>& ids) {
-    for (int id : ids) {
-      if (id < 0 || id > 65535) continue;
-      if (listed.empty()) listed.assign(65536, 0);
-      listed[std::size_t(id)] = 1;
-    }
-  }
+  LabelSet ids;
+  explicit AttachedLabels(const std::vector<int>& list) : ids(list) {}
   /// Whether wall voxel v carries an attached label.
-  bool holds(const VoxelRoles& roles, int64_t v) const {
-    return !listed.empty() && roles.label && listed[roles.label[v]] != 0;
-  }
+  bool holds(const VoxelRoles& roles, int64_t v) const { return roles.label && ids.contains(roles.label[v]); }
 };
 
 /// Marks the nodes of attached interfaces (Mesh::node_attached): for every face between a wall voxel
@@ -184,7 +177,7 @@ struct AttachedLabels {
 void mark_attached_nodes(Mesh& m, const VoxelRoles& roles, int L, const std::vector<int32_t> (&node_id)[kParts],
                          const Lattice& lat, const AttachedLabels& attached) {
   m.node_attached.assign(std::size_t(m.node_count()), 0);
-  if (attached.listed.empty()) return;
+  if (attached.ids.empty()) return;
   const Geometry& g = roles.geometry;
   auto mark_cube = [&](int p, int64_t i, int64_t j, int64_t k) {
     const int64_t a = i / L, b = j / L, c = k / L;

@@ -9,17 +9,12 @@ namespace pneumo {
 
 int64_t gas_voxels_anterior_to(const std::vector<uint16_t>& labels, const Geometry& g, uint16_t gas_label,
                                const std::vector<int>& ids) {
-  std::vector<uint8_t> listed(65536, 0);
-  for (int id : ids)
-    if (id >= 0 && id < 65536) listed[std::size_t(id)] = 1;
   const SliceFrame f = slice_frame(g);
+  const std::vector<int64_t> fronts = front_of_labels(labels.data(), f, LabelSet(ids));
   int64_t count = 0;
   for (int64_t s = 0; s < f.n_si; ++s)
     for (int64_t l = 0; l < f.n_lat; ++l) {
-      // The most anterior listed voxel of the column, in "anteriority" (larger = more anterior).
-      int64_t front = -1;
-      for (int64_t a = 0; a < f.n_ap; ++a)
-        if (listed[labels[std::size_t(f.index(l, a, s))]]) front = std::max(front, f.ant(a));
+      const int64_t front = fronts[std::size_t(s * f.n_lat + l)];
       if (front < 0) continue;
       for (int64_t a = 0; a < f.n_ap; ++a)
         if (f.ant(a) > front && labels[std::size_t(f.index(l, a, s))] == gas_label) ++count;

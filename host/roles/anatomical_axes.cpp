@@ -1,5 +1,7 @@
 #include "roles/anatomical_axes.h"
 
+#include <algorithm>
+
 #include <cmath>
 
 namespace pneumo {
@@ -42,6 +44,19 @@ SliceFrame slice_frame(const Geometry& g) {
   f.h_si = g.spacing_mm[f.si];
   f.ap_sign = ax.sign[1];
   return f;
+}
+
+std::vector<int64_t> front_of_labels(const uint16_t* label, const SliceFrame& f, const LabelSet& ids) {
+  std::vector<int64_t> front(std::size_t(f.n_si * f.n_lat), -1);
+  if (!label || ids.empty()) return front;
+#pragma omp parallel for schedule(static)
+  for (int64_t s = 0; s < f.n_si; ++s)
+    for (int64_t l = 0; l < f.n_lat; ++l) {
+      int64_t& most = front[std::size_t(s * f.n_lat + l)];
+      for (int64_t a = 0; a < f.n_ap; ++a)
+        if (ids.contains(label[f.index(l, a, s)])) most = std::max(most, f.ant(a));
+    }
+  return front;
 }
 
 }  // namespace pneumo

@@ -4,8 +4,10 @@
 // flipped, or with its slices along another axis is treated exactly like the RAS one.
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "core/geometry.h"
+#include "domain/label_set.h"
 
 namespace pneumo {
 
@@ -32,5 +34,11 @@ struct SliceFrame {
   int64_t ant(int64_t a) const { return ap_sign > 0 ? a : n_ap - 1 - a; }
 };
 SliceFrame slice_frame(const Geometry& g);
+
+/// For each axial column (lat l, slice s) of `f`, at s·n_lat + l: the anteriority (SliceFrame::ant)
+/// of its most anterior voxel whose label is in `ids`; -1 where the column holds none. What lies in
+/// front of such a voxel in its column is "anterior to" the labelled organ (the space of Retzius in
+/// front of the bladder, auto_roles.h rule 5b; the gas there, pipeline/cavity_measures.h).
+std::vector<int64_t> front_of_labels(const uint16_t* label, const SliceFrame& f, const LabelSet& ids);
 
 }  // namespace pneumo

@@ -7,6 +7,7 @@
 
 #include "core/log.h"
 #include "core/progress.h"
+#include "roles/anatomical_axes.h"
 #include "roles/back_region.h"
 #include "roles/body_mask.h"
 #include "roles/distance_transform.h"
@@ -107,14 +108,11 @@ void assign_the_shell(std::vector<Role>& role, const std::vector<uint8_t>& body,
 /// Rule 5b: undecided voxels anterior to a prevesical label in the same axial column → wall.
 void attach_prevesical_space(std::vector<Role>& role, const uint16_t* label, const SliceFrame& f, const RoleRules& r) {
   if (!label || r.auto_prevesical_labels.empty()) return;
-  std::vector<uint8_t> listed(65536, 0);
-  for (int id : r.auto_prevesical_labels) listed[std::size_t(id)] = 1;
+  const std::vector<int64_t> fronts = front_of_labels(label, f, LabelSet(r.auto_prevesical_labels));
 #pragma omp parallel for schedule(static)
   for (int64_t s = 0; s < f.n_si; ++s)
     for (int64_t l = 0; l < f.n_lat; ++l) {
-      int64_t front = -1;   // anteriority of the column's most anterior listed voxel
-      for (int64_t a = 0; a < f.n_ap; ++a)
-        if (listed[label[f.index(l, a, s)]]) front = std::max(front, f.ant(a));
+      const int64_t front = fronts[std::size_t(s * f.n_lat + l)];
       if (front < 0) continue;
       for (int64_t a = 0; a < f.n_ap; ++a) {
         const int64_t v = f.index(l, a, s);
