@@ -399,6 +399,17 @@ TEST(SceneRules, LabelInTwoRoleListsNamesBoth) {
   EXPECT_CONTAINS(e, "label 5 is in both roles.wall_labels and roles.viscera_labels");
 }
 
+TEST(SceneRules, AnAttachedLabelWithAnotherRoleIsRefused) {
+  const json attached = {{"attached_labels", {2, 7}}};
+  for (const char* key : {"viscera_labels", "fixed_labels", "other_labels"}) {
+    const std::string e = error_of({{"roles", {{"wall_labels", {2}}, {key, json::array({7})}}}, {"mesh", attached}});
+    EXPECT_CONTAINS(e, "mesh.attached_labels[1]");
+    EXPECT_CONTAINS(e, std::string("is in roles.") + key);
+  }
+  // A wall label, or one no list names (the automatic roles decide it), is accepted.
+  EXPECT_NO_THROW(parse_scene({{"roles", {{"wall_labels", {2}}}}, {"mesh", attached}}, kOrigin));
+}
+
 TEST(SceneRules, RoiBothOrNeitherAndOrdered) {
   EXPECT_CONTAINS(error_of({{"mesh", {{"roi_min_mm", {0, 0, 0}}}}}),
                   "mesh.roi_min_mm is set but mesh.roi_max_mm is not");

@@ -1,5 +1,6 @@
 // Rules that involve more than one key, checked after every key passed its own checks. Messages
 // have the same shape as the table's: file, key path, value, what is wrong.
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <string>
@@ -29,6 +30,19 @@ void check_role_lists(const RoleRules& r, const At& roles) {
                          roles.child(it->second).path + " and " + roles.child(key).path +
                          "; a label has one role");
     }
+}
+
+// An attached label is a wall label (the parietal side the viscera stay on, mesh.h): one the scene
+// gives another role would have no wall voxels to close, and would be ignored without a word.
+void check_attached_labels(const SceneMesh& m, const RoleRules& r, const At& root) {
+  const At list = root.child("mesh").child("attached_labels");
+  for (std::size_t i = 0; i < m.attached_labels.size(); ++i)
+    for (const auto& [key, ids] : {std::pair{"viscera_labels", &r.viscera_labels},
+                                   {"fixed_labels", &r.fixed_labels}, {"other_labels", &r.other_labels}})
+      if (std::find(ids->begin(), ids->end(), m.attached_labels[i]) != ids->end())
+        list.item(i).fail_value(m.attached_labels[i], std::string("is in ") + root.child("roles").child(key).path +
+                                                          "; attached labels are wall labels (the side the "
+                                                          "viscera stay on): list it in roles.wall_labels");
 }
 
 void check_roi(const SceneMesh& m, const At& mesh) {
@@ -183,6 +197,7 @@ void validate_scene(const Scene& s, const ReadContext& ctx) {
   const At root{&ctx, ""};
   check_role_lists(s.roles, root.child("roles"));
   check_roi(s.mesh, root.child("mesh"));
+  check_attached_labels(s.mesh, s.roles, root);
   check_label_young(s.material, root.child("material"));
   check_material_model(s, root);
   check_transfer_function(s.render, root.child("render"));
