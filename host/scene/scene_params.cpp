@@ -1,7 +1,7 @@
 // THE parameter table: every scene key, its unit, what it allows and what it means. The parser,
 // the echo, the messages and docs/scene_reference.md are all made from these tables; the
 // defaults are the member initialisers in scene.h (see the comments there for their sources).
-// §n = a section of design/method.md.
+// §n = a section of docs/method.md.
 #include <cctype>
 #include <string>
 

@@ -86,7 +86,7 @@ std::string scene_reference_markdown() {
         "- `//` and `/* */` comments are allowed; a key may appear only once in an object.\n"
         "- Each run writes the scene it used, with every default filled in and paths resolved, beside its "
         "outputs; that file reads back as the same scene.\n"
-        "- §n refers to a section of design/method.md.\n\n";
+        "- §n refers to a section of docs/method.md.\n\n";
   write_table(md, scene_detail::scene_table(), "", "Top level");
   md << "## The default scene\n\n"
         "Every key at its default, as a run writes it (keys in alphabetical order):\n\n"
