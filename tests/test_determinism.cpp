@@ -40,7 +40,7 @@ Scene phantom_scene(const ScratchDir& dir) {
   return scene;
 }
 
-/// metrics.json or render.json without the wall-clock timings: the documented exception (README).
+/// metrics.json or render.json without the wall-clock timings: the documented exception (docs/robustness.md).
 nlohmann::json without_timings(nlohmann::json m) {
   m.erase("wall_time_s");
   m.erase("stage_seconds");

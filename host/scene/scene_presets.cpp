@@ -49,7 +49,7 @@ std::optional<ScenePreset> find_preset(const nlohmann::json& scene) {
 
 const std::string& preset_reference_text() {
   static const std::string text = [] {
-    std::string t = "Speed against accuracy, measured by `pneumo bench` (README, bench/results/2026-11-23-bench.md: the "
+    std::string t = "Speed against accuracy, measured by `pneumo bench` (docs/performance.md, bench/results/2026-11-23-bench.md: the "
                     "medium phantom, CPU 1 thread, error at skin and cavity points against 4.5 mm cubes): sets "
                     "mesh.cube_mm, solver.method and solver.residual_tolerance unless the scene gives them. "
                     "\"none\": the defaults.";
