@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "core/progress.h"
+#include "io/label_table.h"
 #include "io/volume_io.h"
 #include "phantom/phantom.h"
 
@@ -388,6 +389,7 @@ TEST(PhantomScene, JsonFollowsTheSchemaAndTheLabelTable) {
     EXPECT_TRUE(j.at("description").is_string());
     EXPECT_EQ(j.at("inputs").at("ct"), "ct.nii.gz");
     EXPECT_EQ(j.at("inputs").at("labels"), "labels.nii.gz");
+    EXPECT_EQ(j.at("inputs").at("label_names"), "label_names.csv");
     const auto& roles = j.at("roles");
     EXPECT_EQ(roles.at("source"), "labels");
     EXPECT_EQ(roles.at("unlisted_label_role"), "other");
@@ -412,7 +414,12 @@ TEST(PhantomCase, WritesCtLabelsAndSceneThatReadBack) {
   fs::remove_all(dir.parent_path());
   const Phantom& p = phantom(PhantomSize::Small);
   write_phantom_case(p, PhantomSize::Small, dir.string());
-  for (const char* f : {"ct.nii.gz", "labels.nii.gz", "scene.json"}) EXPECT_TRUE(fs::is_regular_file(dir / f)) << f;
+  for (const char* f : {"ct.nii.gz", "labels.nii.gz", "label_names.csv", "scene.json"})
+    EXPECT_TRUE(fs::is_regular_file(dir / f)) << f;
+  // Every phantom id named, as phantom_labels() names it.
+  const std::map<int, std::string> names = read_label_names((dir / "label_names.csv").string());
+  EXPECT_EQ(names.size(), phantom_labels().size());
+  for (const PhantomLabel& l : phantom_labels()) EXPECT_EQ(names.at(l.id), l.name);
   const Volume ct = read_volume((dir / "ct.nii.gz").string());
   const Volume labels = read_volume((dir / "labels.nii.gz").string());
   EXPECT_EQ(ct.type(), VoxelType::Int16);

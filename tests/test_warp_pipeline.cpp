@@ -207,6 +207,7 @@ TEST_F(WarpPipeline, DeformationOfAnotherMeshOrTruncatedIsBadInput) {
   }
   scene["inputs"]["ct"] = path("case/ct.nii.gz");
   scene["inputs"]["labels"] = path("case/labels.nii.gz");
+  scene["inputs"]["label_names"] = path("case/label_names.csv");
   scene["mesh"]["cube_voxels"] = 3;
   std::ofstream(dir.file("other.json")) << scene.dump();
   const std::string sim = dir.file("sim");

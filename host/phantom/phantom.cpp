@@ -133,7 +133,7 @@ std::string phantom_scene_json(PhantomSize size) {
                      " voxels at " + nlohmann::json(g.spacing_mm.x()).dump() +
                      " mm, RAS), supine on a CT table; labels use TotalSegmentator v2 ids where they exist, 200+ "
                      "otherwise.";
-  j["inputs"] = {{"ct", "ct.nii.gz"}, {"labels", "labels.nii.gz"}};
+  j["inputs"] = {{"ct", "ct.nii.gz"}, {"labels", "labels.nii.gz"}, {"label_names", "label_names.csv"}};
   j["roles"] = {{"source", "labels"},
                 {"wall_labels", wall},
                 {"viscera_labels", viscera},
@@ -165,6 +165,9 @@ void write_phantom_case(const Phantom& phantom, PhantomSize size, const std::str
   const fs::path d(dir);
   write_volume(phantom.ct, (d / "ct.nii.gz").string());
   write_volume(phantom.labels, (d / "labels.nii.gz").string());
+  std::string names = "label_id,name\n";
+  for (const PhantomLabel& l : phantom_labels()) names += std::to_string(l.id) + "," + l.name + "\n";
+  write_text_file_atomic((d / "label_names.csv").string(), names);
   write_text_file_atomic((d / "scene.json").string(), phantom_scene_json(size) + "\n");
 }
 

@@ -57,7 +57,8 @@ int phantom_cube_voxels(PhantomSize size);
 /// The scene JSON (method.md roles built from phantom_labels()), pretty-printed with a 2-space indent.
 std::string phantom_scene_json(PhantomSize size);
 
-/// Creates `dir` if needed and writes ct.nii.gz, labels.nii.gz and scene.json into it, each atomically.
+/// Creates `dir` if needed and writes ct.nii.gz, labels.nii.gz, label_names.csv (id, name) and
+/// scene.json into it, each atomically.
 void write_phantom_case(const Phantom& phantom, PhantomSize size, const std::string& dir);
 
 }  // namespace pneumo

@@ -31,7 +31,8 @@ namespace fs = std::filesystem;
 /// What a run writes at the top of its folder, and the folders it fills: an earlier run's copies are
 /// removed before a forced run, so nothing stale sits beside the new results.
 const char* const kRunFiles[] = {"report.html",       "metrics.json",           "render.json",
-                                 "deformed_ct.nii.gz", "deformed_labels.nii.gz", "slices_before_after.png",
+                                 "deformed_ct.nii.gz", "deformed_labels.nii.gz", "deformed_labels.ctbl",
+                                 "deformed_labels_itksnap.txt", "slices_before_after.png",
                                  "mesh_initial.vtu",  "mesh_deformed.vtu",      "deformation.bin",
                                  "convergence.csv",   "convergence.svg",        "pressure_volume.csv",
                                  "pressure_volume.svg", "scene_used.json",      "roles.png"};
@@ -83,6 +84,7 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   log::info("stage 1/4: roles, mesh and solver");
   Simulation sim = prepare_simulation(scene);
   check_cavity_label_free(scene, sim.roles);
+  scene_label_names(scene);   // a bad names file is refused now, not after the solve
   SolveHooks hooks;
   if (o.resume && fs::exists(checkpoint)) {
     const Deformation c = read_deformation(checkpoint, sim.mesh);

@@ -15,6 +15,7 @@
 #include "image/png.h"
 #include "pipeline/cavity_measures.h"
 #include "pipeline/scene_stages.h"
+#include "render/render_volume.h"
 #include "report/slices.h"
 #include "roles/connected_components.h"
 #include "warp/cavity_specks.h"
@@ -98,6 +99,7 @@ void check_cavity_label_free(const Scene& scene, const RoleVolume& roles) {
 
 WarpedCase warp_scene(const Scene& scene, const std::string& sim_dir) {
   read_metrics(sim_dir);   // a finished simulation, before reading a large CT for nothing
+  scene_label_names(scene);
   Volume ct = read_volume(scene.require_ct());
   std::optional<Volume> labels;
   if (!scene.inputs.labels.empty()) labels = read_volume(scene.inputs.labels);
@@ -117,6 +119,7 @@ WarpedCase warp_scene(const Scene& scene, const std::string& sim_dir) {
 WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labels, RoleVolume roles, Mesh mesh,
                        Deformation deformation) {
   WarpedCase w;
+  w.label_names = scene_label_names(scene);
   w.ct = std::move(ct);
   w.labels = std::move(labels);
   w.roles = std::move(roles);
@@ -187,6 +190,43 @@ Volume deformed_ct_volume(const WarpedCase& w) {
     fill_rounded<T>(v, w.result.ct_hu);
   });
   return v;
+}
+
+std::map<int, std::string> scene_label_names(const Scene& scene) {
+  if (scene.inputs.label_names.empty()) return {};
+  return read_label_names(scene.inputs.label_names);
+}
+
+std::vector<LabelTableEntry> deformed_label_entries(const Scene& scene, const WarpedCase& w) {
+  std::vector<uint8_t> present(65536, 0);
+  for (const uint16_t l : w.result.labels) present[l] = 1;
+  const LabelColours colours = default_label_colours();
+  std::vector<LabelTableEntry> rows = {{0, "background", {0, 0, 0}, 0.0}};
+  for (int id = 1; id < 65536; ++id) {
+    if (!present[id]) continue;
+    LabelTableEntry e;
+    e.id = id;
+    const auto name = w.label_names.find(id);
+    e.name = name != w.label_names.end() ? name->second : "label " + std::to_string(id);
+    const auto& c = colours.rgba[std::size_t(id)];
+    if (c[3] > 0) {
+      e.rgb = {c[0], c[1], c[2]};
+    } else {
+      // A fixed palette for ids the renderer does not colour: hues a golden angle apart, so
+      // neighbouring ids differ (HSV with s = 0.55, v = 0.85).
+      const double h = std::fmod(id * 137.508, 360.0) / 60.0, s = 0.55, v = 0.85;
+      const double x = v * s * (1.0 - std::abs(std::fmod(h, 2.0) - 1.0)), m = v - v * s;
+      const double rgb[6][3] = {{v * s, x, 0}, {x, v * s, 0}, {0, v * s, x}, {0, x, v * s}, {x, 0, v * s}, {v * s, 0, x}};
+      const double* p = rgb[std::min(5, int(h))];
+      for (int k = 0; k < 3; ++k) e.rgb[k] = uint8_t(std::lround(255.0 * (p[k] + m)));
+    }
+    if (id == scene.output.cavity_label) {
+      e.name = "CO2 cavity";
+      e.rgb = {60, 160, 255};   // the slices' overlay colour
+    }
+    rows.push_back(e);
+  }
+  return rows;
 }
 
 Volume deformed_label_volume(const WarpedCase& w, int cavity_label) {
@@ -274,8 +314,13 @@ void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir)
   if (metrics.erase("warp") > 0) write_text_file_atomic(in_dir(dir, "metrics.json"), metrics.dump(2) + "\n");
   WarpOutputs outputs(dir);
   if (scene.output.write_deformed_ct) write_volume(deformed_ct_volume(w), outputs.add("deformed_ct.nii.gz"));
-  if (scene.output.write_deformed_labels && w.labels)
+  if (scene.output.write_deformed_labels && w.labels) {
     write_volume(deformed_label_volume(w, scene.output.cavity_label), outputs.add("deformed_labels.nii.gz"));
+    // Their names and colours, for 3D Slicer and ITK-SNAP.
+    const std::vector<LabelTableEntry> rows = deformed_label_entries(scene, w);
+    write_slicer_colour_table(outputs.add("deformed_labels.ctbl"), rows);
+    write_itksnap_label_description(outputs.add("deformed_labels_itksnap.txt"), rows);
+  }
   if (scene.output.write_slices) {
     const Volume after = deformed_ct_volume(w);
     std::vector<uint8_t> gas(w.result.outcome.size());

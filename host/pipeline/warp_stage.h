@@ -3,11 +3,13 @@
 // --out DIR`, and what the pipeline reuses. Rebuilds roles and mesh from the scene (deterministic),
 // reads DIR/deformation.bin (refused when it belongs to another mesh), warps the CT and labels
 // (method.md §7) on the scene's device, and writes the results on the input CT's own grid.
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 
+#include "io/label_table.h"
 #include "io/volume.h"
 #include "mesh/deformation_file.h"
 #include "mesh/mesh.h"
@@ -33,6 +35,7 @@ struct WarpedCase {
   std::optional<Vec3> cavity_centroid_mm;   // none when no voxel became gas
   double seconds_warp = 0.0;
   SpeckFill specks;               // gas pieces below output.min_cavity_piece_ml, filled
+  std::map<int, std::string> label_names;   // inputs.label_names, read before the warp (empty: unset)
 
   int64_t cavity_voxels() const { return result.gas_voxels; }
   double cavity_volume_ml() const { return double(result.gas_voxels) * voxel_volume_ml; }
@@ -70,6 +73,15 @@ WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labe
 /// The deformed CT in the input's voxel type where it can hold HU (int16, int32 rounded to the
 /// nearest HU; float32, float64 as computed), float32 otherwise (unsigned or 8-bit types).
 Volume deformed_ct_volume(const WarpedCase& w);
+/// The scene's inputs.label_names (io/label_table.h), empty when unset: read before any long work so
+/// that a bad file is refused at once.
+std::map<int, std::string> scene_label_names(const Scene& scene);
+
+/// The label tables' rows for the deformed labels: background, every id they hold (named from
+/// w.label_names, else "label N") in the renderer's organ colours (else a fixed palette), and the
+/// cavity, named "CO2 cavity".
+std::vector<LabelTableEntry> deformed_label_entries(const Scene& scene, const WarpedCase& w);
+
 /// The deformed label map in the input's type when it holds the cavity label, else uint16.
 Volume deformed_label_volume(const WarpedCase& w, int cavity_label);
 

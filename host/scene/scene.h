@@ -27,6 +27,7 @@ namespace pneumo {
 struct SceneInputs {
   std::string ct;       // "" = not given; see Scene::require_ct()
   std::string labels;   // "" = not given
+  std::string label_names;   // "" = not given: a CSV of label_id,name (io/label_table.h)
 };
 
 struct SceneMesh {

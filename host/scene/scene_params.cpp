@@ -87,6 +87,10 @@ const Table<SceneInputs>& inputs_table() {
        "CT volume (.nii, .nii.gz, .mhd). Unset is accepted here; commands that need a CT say so."},
       {"labels", &SceneInputs::labels, "", file_path(),
        "Label map on the CT's voxel grid (integer ids): roles and organ colours."},
+      {"label_names", &SceneInputs::label_names, "", file_path(),
+       "CSV naming the label map's ids (a header with \"label_id\" and \"name\"; "
+       "data/label_tables/totalsegmentator_total.csv for TotalSegmentator): the names of the label tables "
+       "written beside deformed_labels (3D Slicer, ITK-SNAP). Unset: \"label N\"."},
   };
   return t;
 }
