@@ -95,7 +95,7 @@ void write_itksnap_label_description(const std::string& path, const std::vector<
         "#    -B-:   Blue color component (0..255)\n"
         "#    -A-:   Label transparency (0.00 .. 1.00)\n"
         "#    VIS:   Label visibility (0 or 1)\n"
-        "#    IDX:   Label mesh visibility (0 or 1)\n"
+        "#    MSH:   Label mesh visibility (0 or 1)\n"
         "#  LABEL:   Label description \n"
         "################################################\n";
   for (const LabelTableEntry& e : entries) {
