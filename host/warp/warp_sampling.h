@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -75,7 +76,11 @@ struct SourceGrid {
     // stencil's neighbours along i are adjacent floats, loaded and widened as pairs.
     const int64_t y = dims[0], z = dims[0] * dims[1];
     auto pair = [](const float* at) {   // (at[0], at[1]) as doubles
-      return _mm_cvtps_pd(_mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(at))));
+      // The two floats' 8 bytes, loaded as one: memcpy, since `at` is only 4-byte aligned and a
+      // double read through it would be undefined (UBSan found it); compilers emit the same movsd.
+      double two;
+      std::memcpy(&two, at, sizeof two);
+      return _mm_cvtps_pd(_mm_castpd_ps(_mm_set_sd(two)));
     };
     const __m128d p00 = pair(c), p10 = pair(c + y), p01 = pair(c + z), p11 = pair(c + z + y);
     const __m128d wx0 = _mm_set1_pd(1 - fx), wx1 = _mm_set1_pd(fx);
