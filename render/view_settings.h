@@ -67,6 +67,7 @@ struct ViewSettings {
   std::vector<Camera> cameras;
   std::vector<Port> ports;
   std::vector<CameraPath> paths;
+  double video_fps = 25.0;        // frame rate of the fly-through and inflation-preview MP4s
 };
 
 }  // namespace pneumo

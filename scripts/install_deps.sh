@@ -13,8 +13,8 @@ packages=(
   libeigen3-dev
   # offscreen OpenGL: EGL (primary), OSMesa (fallback), GL headers
   libegl-dev libgl-dev libopengl-dev libgles-dev libosmesa6-dev libegl-mesa0 mesa-utils
-  # image output
-  libstb-dev
+  # image output; ffmpeg (with ffprobe) encodes the fly-through and inflation-preview MP4s
+  libstb-dev ffmpeg
   # volume I/O
   libnifti2-dev zlib1g-dev
   # CLI and scenes

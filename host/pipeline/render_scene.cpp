@@ -63,10 +63,14 @@ RenderSettings settings_from_scene(const ViewSettings& r, const Geometry& g) {
 
 bool ffmpeg_available() { return std::system("command -v ffmpeg >/dev/null 2>&1") == 0; }
 
-// frames → <dir>.mp4 (H.264, 25 frames/s); written beside and renamed, so it is atomic too.
-bool encode_mp4(const fs::path& frame_dir, const fs::path& mp4) {
+// frames → <dir>.mp4 (H.264); written beside and renamed, so it is atomic too. The input rate is the
+// playback rate: every PNG becomes one frame, none dropped or repeated.
+bool encode_mp4(const fs::path& frame_dir, const fs::path& mp4, double fps) {
   const fs::path tmp = mp4.string() + ".part.mp4";
-  const std::string cmd = "ffmpeg -y -loglevel error -framerate 25 -i '" + (frame_dir / "frame_%04d.png").string() +
+  char rate[32];
+  std::snprintf(rate, sizeof rate, "%.6g", fps);
+  const std::string cmd = std::string("ffmpeg -y -loglevel error -framerate ") + rate + " -i '" +
+                          (frame_dir / "frame_%04d.png").string() +
                           "' -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -c:v libx264 -pix_fmt yuv420p '" + tmp.string() +
                           "' </dev/null";
   if (std::system(cmd.c_str()) != 0) {
@@ -202,9 +206,10 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Vol
       tick(p.name + " " + std::to_string(f + 1) + "/" + std::to_string(p.cameras.size()));
     }
     nlohmann::json j = {{"name", p.name}, {"frames", p.cameras.size()}, {"folder", "flythrough/" + p.name}};
-    if (mp4 && encode_mp4(dir, out / "flythrough" / (p.name + ".mp4"))) {
+    if (mp4 && encode_mp4(dir, out / "flythrough" / (p.name + ".mp4"), r.video_fps)) {
       run.files.push_back("flythrough/" + p.name + ".mp4");
       j["mp4"] = "flythrough/" + p.name + ".mp4";
+      j["fps"] = r.video_fps;
     }
     path_report.push_back(j);
   }

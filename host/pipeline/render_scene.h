@@ -53,9 +53,9 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& options, const
 /// render.step_fraction of its smallest spacing).
 RenderSettings settings_from_scene(const ViewSettings& r, const Geometry& g);
 
-/// Whether ffmpeg is on PATH, and frames frame_0001.png … in `frame_dir` → `mp4` (H.264, 25 frames/s,
-/// written beside and renamed; false with a warning when ffmpeg fails).
+/// Whether ffmpeg is on PATH, and frames frame_0001.png … in `frame_dir` → `mp4` (H.264 at `fps`
+/// frames/s, written beside and renamed; false with a warning when ffmpeg fails).
 bool ffmpeg_available();
-bool encode_mp4(const std::filesystem::path& frame_dir, const std::filesystem::path& mp4);
+bool encode_mp4(const std::filesystem::path& frame_dir, const std::filesystem::path& mp4, double fps);
 
 }  // namespace pneumo

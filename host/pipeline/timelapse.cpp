@@ -84,7 +84,7 @@ int Timelapse::finish() {
   const fs::path root = fs::path(out_dir_) / "timelapse";
   if (frames_ > 1 && ffmpeg_available() && fs::exists(root))
     for (const auto& e : fs::directory_iterator(root))
-      if (e.is_directory()) encode_mp4(e.path(), root / (e.path().filename().string() + ".mp4"));
+      if (e.is_directory()) encode_mp4(e.path(), root / (e.path().filename().string() + ".mp4"), scene_.render.video_fps);
   return frames_;
 }
 

@@ -386,6 +386,8 @@ const Table<ViewSettings>& render_table() {
       {"ports", &ViewSettings::ports, port_table(), any().items(0, 256),
        "Views from trocar ports on the skin, aimed at a point or an organ."},
       {"paths", &ViewSettings::paths, path_table(), any().items(0, 64), "Fly-throughs along keyframes."},
+      {"video_fps", &ViewSettings::video_fps, "frames/s", in(1, 120),
+       "Frame rate of the fly-through and inflation-preview MP4s: a path of N frames plays for N / video_fps s."},
   };
   return t;
 }
