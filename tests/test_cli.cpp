@@ -40,6 +40,16 @@ TEST(Cli, UnknownSubcommandOrOptionIsBadInput) {
   EXPECT_EQ(run_pneumo("").code, 2);
 }
 
+TEST(Cli, GlobalOptionsWorkAfterTheSubcommand) {
+  // After a subcommand, and after a nested one, as before it.
+  for (const char* line : {"validate lattice -q", "validate -q lattice", "-q validate lattice"}) {
+    auto r = run_pneumo(line);
+    EXPECT_EQ(r.code, 0) << line << ": " << r.err;
+    EXPECT_TRUE(r.err.empty()) << line << ": " << r.err;
+  }
+  EXPECT_EQ(run_pneumo("devices --json -v").code, 0);
+}
+
 TEST(Cli, BadFilesGiveOneLineNamingTheFileAndExitTwo) {
   ScratchDir d;
   { std::ofstream(d.file("garbage.nii")) << "this is not a NIfTI file at all, just text that goes on"; }

@@ -1,6 +1,7 @@
 // pneumo: one executable whose subcommands map one to one onto library calls.
 // Exit codes: 0 success, 1 failure, 2 bad input (a file, a scene, an argument).
 #include <cstdio>
+#include <functional>
 #include <iostream>
 #include <vector>
 
@@ -27,7 +28,15 @@ int main(int argc, char** argv) {
   auto add = [&](cli::Run (*make)(CLI::App&)) {
     const std::size_t before = app.get_subcommands({}).size();
     cli::Run run = make(app);
-    commands.emplace_back(app.get_subcommands({})[before], std::move(run));
+    CLI::App* sub = app.get_subcommands({})[before];
+    // -v and -q anywhere on the line: after the subcommand too, and after its own ones
+    // (`validate lattice -q`).
+    std::function<void(CLI::App*)> fall_through = [&](CLI::App* a) {
+      a->fallthrough();
+      for (CLI::App* nested : a->get_subcommands({})) fall_through(nested);
+    };
+    fall_through(sub);
+    commands.emplace_back(sub, std::move(run));
   };
   add(cli::add_info);
   add(cli::add_devices);
