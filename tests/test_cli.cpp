@@ -41,13 +41,31 @@ TEST(Cli, UnknownSubcommandOrOptionIsBadInput) {
 }
 
 TEST(Cli, GlobalOptionsWorkAfterTheSubcommand) {
-  // After a subcommand, and after a nested one, as before it.
-  for (const char* line : {"validate lattice -q", "validate -q lattice", "-q validate lattice"}) {
+  // -v after the subcommand reaches the log: --threads' debug line shows, as it does before it.
+  for (const char* line : {"-v --threads 1 devices", "devices --threads 1 -v", "devices -v --threads=1"}) {
     auto r = run_pneumo(line);
     EXPECT_EQ(r.code, 0) << line << ": " << r.err;
-    EXPECT_TRUE(r.err.empty()) << line << ": " << r.err;
+    EXPECT_NE(r.err.find("CPU threads: 1"), std::string::npos) << line << ": " << r.err;
   }
-  EXPECT_EQ(run_pneumo("devices --json -v").code, 0);
+  auto q = run_pneumo("validate lattice -q");
+  EXPECT_EQ(q.code, 0) << q.err;
+  EXPECT_TRUE(q.err.empty()) << q.err;
+}
+
+TEST(Cli, ThreadsSetsPoclsCpuDeviceAndIsBounded) {
+  for (int n : {1, 3}) {
+    auto r = run_pneumo("devices --json --threads " + std::to_string(n));
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    for (std::size_t i = 1; i < j.size(); ++i)
+      if (j[i]["platform"].get<std::string>().find("Portable Computing Language") != std::string::npos)
+        EXPECT_EQ(j[i]["compute_units"], n) << j[i].dump();
+  }
+  for (const char* bad : {"0", "-2", "1025", "two"}) {
+    auto r = run_pneumo(std::string("--threads ") + bad + " devices");
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_NE(r.err.find("--threads"), std::string::npos) << bad << ": " << r.err;
+  }
 }
 
 TEST(Cli, BadFilesGiveOneLineNamingTheFileAndExitTwo) {

@@ -3,12 +3,14 @@
 #include <cstdio>
 #include <functional>
 #include <iostream>
+#include <string>
 #include <vector>
 
 #include "cli/commands.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
+#include "core/thread_count.h"
 
 namespace {
 constexpr int kExitFailure = 1;
@@ -23,13 +25,16 @@ int main(int argc, char** argv) {
   bool verbose = false, quiet = false;
   app.add_flag("-v,--verbose", verbose, "Show debug messages (device, build options, timings)");
   app.add_flag("-q,--quiet", quiet, "Show errors only (no progress)");
+  int threads = 0;
+  CLI::Option* threads_option = app.add_option(
+      "--threads", threads, "CPU threads for pneumo's loops and PoCL's CPU device, 1 to 1024 (default: every core)");
 
   std::vector<std::pair<CLI::App*, cli::Run>> commands;
   auto add = [&](cli::Run (*make)(CLI::App&)) {
     const std::size_t before = app.get_subcommands({}).size();
     cli::Run run = make(app);
     CLI::App* sub = app.get_subcommands({})[before];
-    // -v and -q anywhere on the line: after the subcommand too, and after its own ones
+    // -v, -q and --threads anywhere on the line: after the subcommand too, and after its own ones
     // (`validate lattice -q`).
     std::function<void(CLI::App*)> fall_through = [&](CLI::App* a) {
       a->fallthrough();
@@ -65,6 +70,7 @@ int main(int argc, char** argv) {
   }
 
   try {
+    if (threads_option->count() > 0) set_thread_count(threads);
     for (auto& [sub, run] : commands)
       if (sub->parsed()) return run();
     return kExitBadInput;
