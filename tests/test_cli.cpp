@@ -40,6 +40,21 @@ TEST(Cli, UnknownSubcommandOrOptionIsBadInput) {
   EXPECT_EQ(run_pneumo("").code, 2);
 }
 
+TEST(Cli, AnUnknownSubcommandIsNamedWithTheClosestOne) {
+  auto typo = run_pneumo("-v simulat scene.json");
+  EXPECT_EQ(typo.code, 2);
+  EXPECT_EQ(count_lines(typo.err), 1) << typo.err;
+  EXPECT_NE(typo.err.find("unknown subcommand 'simulat'"), std::string::npos) << typo.err;
+  EXPECT_NE(typo.err.find("did you mean 'simulate'?"), std::string::npos) << typo.err;
+  auto bogus = run_pneumo("--threads 2 bogus");   // a global option's value is not the subcommand
+  EXPECT_EQ(bogus.code, 2);
+  EXPECT_NE(bogus.err.find("unknown subcommand 'bogus'"), std::string::npos) << bogus.err;
+  EXPECT_EQ(bogus.err.find("did you mean"), std::string::npos) << bogus.err;
+  for (const char* sub : {"info", "devices", "phantom", "scene", "roles", "validate", "simulate", "warp", "render",
+                          "run", "bench"})
+    EXPECT_NE(bogus.err.find(sub), std::string::npos) << sub << ": " << bogus.err;
+}
+
 TEST(Cli, GlobalOptionsWorkAfterTheSubcommand) {
   // -v after the subcommand reaches the log: --threads' debug line shows, as it does before it.
   for (const char* line : {"-v --threads 1 devices", "devices --threads 1 -v", "devices -v --threads=1"}) {

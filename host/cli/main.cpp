@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/unknown_subcommand.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
@@ -54,6 +55,15 @@ int main(int argc, char** argv) {
   add(cli::add_render);
   add(cli::add_run);
   add(cli::add_bench);
+
+  std::vector<std::string> names;
+  for (const auto& c : commands) names.push_back(c.first->get_name());
+  const std::string unknown =
+      cli::unknown_subcommand_message(std::vector<std::string>(argv + 1, argv + argc), {"--threads"}, names);
+  if (!unknown.empty()) {
+    std::cerr << "pneumo: error: " << unknown << "\n";
+    return kExitBadInput;
+  }
 
   try {
     app.parse(argc, argv);
