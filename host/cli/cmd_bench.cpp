@@ -10,7 +10,7 @@ namespace pneumo::cli {
 Run add_bench(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "bench", "Measure every stage on every device, the solvers' speed against accuracy and their stable time "
-               "steps (a full run takes about 15-20 minutes on 2 cores; --quick is the seconds-long smoke run)");
+               "steps (a full run takes up to an hour on 2 cores; --quick is the seconds-long smoke run)");
   auto o = std::make_shared<bench::BenchOptions>();
   o->real_ct_scene = "scenes/totalseg_example.json";
   o->real_ct_fem_scene = "scenes/totalseg_example_fem.json";
