@@ -14,6 +14,7 @@
 #include <memory>
 #include <mutex>
 #include <sstream>
+#include <vector>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -350,13 +351,16 @@ Volume read_nifti(const std::string& path) {
   return v;
 }
 
-void write_nifti(const Volume& v, const std::string& path) {
+namespace {
+
+/// Writes `data` (`payload` bytes, NIfTI order) under the header `dims` and `datatype` describe, on
+/// grid `g`: sform (and qform where the direction is a rotation), millimetres, atomically.
+void write_nifti_image(const Geometry& g, const int64_t dims[8], int datatype, const void* data, uint64_t payload,
+                       const std::string& path, int intent_code, const char* intent_name) {
   quiet_niftilib();
   check_writable_target(path);
-  const Geometry& g = v.geometry();
   g.validate(path);
-  const int64_t dims[8] = {3, g.dims[0], g.dims[1], g.dims[2], 1, 1, 1, 1};
-  NimPtr nim(nifti_make_new_nim(dims, nifti_datatype_of(v.type()), 0));
+  NimPtr nim(nifti_make_new_nim(dims, datatype, 0));
   if (!nim) throw std::runtime_error(path + ": niftilib could not create an image header");
 
   nim->nifti_type = NIFTI_FTYPE_NIFTI1_1;
@@ -366,6 +370,8 @@ void write_nifti(const Volume& v, const std::string& path) {
   nim->dz = nim->pixdim[3] = g.spacing_mm[2];
   nim->scl_slope = 1.0;
   nim->scl_inter = 0.0;
+  nim->intent_code = intent_code;
+  std::snprintf(nim->intent_name, sizeof nim->intent_name, "%s", intent_name);
   const Mat4 a = g.index_to_world();
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) nim->sto_xyz.m[r][c] = a(r, c);
@@ -387,13 +393,13 @@ void write_nifti(const Volume& v, const std::string& path) {
   AtomicFile out(path);
   if (nifti_set_filenames(nim.get(), out.temp_path().c_str(), 0, 1) != 0)
     throw std::runtime_error(path + ": niftilib rejected the file name " + out.temp_path());
-  nim->data = const_cast<void*>(v.raw());
+  nim->data = const_cast<void*>(data);
   // zlib level 1: the fastest level (CT compresses little better at the default 6). Returns nothing useful:
   // check what it wrote.
   CapturedStderr niftilib_messages;
   nifti_image_write_hdr_img(nim.get(), 1, "wb1");
   const std::string printed = niftilib_messages.restore();
-  const uint64_t bytes = 352 + v.byte_count();   // header, extender, voxels
+  const uint64_t bytes = 352 + payload;   // header, extender, voxels
   struct stat st {};
   const bool wrote = is_gz(path) ? whole_gzip(out.temp_path(), bytes)
                                  : ::stat(out.temp_path().c_str(), &st) == 0 && uint64_t(st.st_size) >= bytes;
@@ -401,6 +407,28 @@ void write_nifti(const Volume& v, const std::string& path) {
                                        "written under this name");
   if (!printed.empty()) std::fputs(printed.c_str(), stderr);   // niftilib's warnings on a good write
   out.commit();
+}
+
+}  // namespace
+
+void write_nifti(const Volume& v, const std::string& path) {
+  const Geometry& g = v.geometry();
+  const int64_t dims[8] = {3, g.dims[0], g.dims[1], g.dims[2], 1, 1, 1, 1};
+  write_nifti_image(g, dims, nifti_datatype_of(v.type()), v.raw(), v.byte_count(), path, NIFTI_INTENT_NONE, "");
+}
+
+void write_nifti_vectors(const Geometry& g, const float* interleaved, int components, const std::string& path,
+                         const std::string& intent_name) {
+  if (components < 1 || components > 16) throw std::invalid_argument("write_nifti_vectors: 1 to 16 components");
+  // NIfTI-1 §dim: a vector per voxel is dimension 5, after a singleton time axis (dim[4] = 1), and the
+  // components are the slowest index, so each one is a whole volume in the file.
+  const int64_t dims[8] = {5, g.dims[0], g.dims[1], g.dims[2], 1, components, 1, 1};
+  const std::size_t n = std::size_t(g.voxel_count()), m = std::size_t(components);
+  std::vector<float> planar(n * m);
+  for (std::size_t c = 0; c < m; ++c)
+    for (std::size_t v = 0; v < n; ++v) planar[c * n + v] = interleaved[v * m + c];
+  write_nifti_image(g, dims, NIFTI_TYPE_FLOAT32, planar.data(), planar.size() * sizeof(float), path,
+                    NIFTI_INTENT_VECTOR, intent_name.c_str());
 }
 
 }  // namespace pneumo

@@ -28,6 +28,11 @@ Volume read_nifti(const std::string& path);
 void write_nifti(const Volume& v, const std::string& path);
 Volume read_metaimage(const std::string& path);
 void write_metaimage(const Volume& v, const std::string& path, bool compress);
+/// A float32 vector per voxel as a NIfTI-1 vector image (dim 5, intent NIFTI_INTENT_VECTOR, the
+/// components written as given, `intent_name` at most 15 characters): `interleaved` holds `components`
+/// values per voxel of `g`, voxels i fastest. Atomic, as every writer here.
+void write_nifti_vectors(const Geometry& g, const float* interleaved, int components, const std::string& path,
+                         const std::string& intent_name);
 
 /// Largest voxel payload pneumo agrees to read (bytes): a header promising more is refused
 /// before anything is allocated. 32 GiB: larger than any clinical CT, smaller than absurd.
