@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs every build and run dependency of pneumo from Debian 12 packages.
 # Idempotent and non-interactive; run as root (or with sudo available).
-#   --peers  also what the peer tools in ../shared/peers need (VTK, SciPy, ITK, GLEW), for bench/peers/.
+#   --peers  also what the peer tools in ../shared/peers need beyond the tests' set (SciPy, GLEW), for bench/peers/.
 set -euo pipefail
 
 packages=(
@@ -19,11 +19,12 @@ packages=(
   libnifti2-dev zlib1g-dev
   # CLI and scenes
   libcli11-dev nlohmann-json3-dev
-  # tests and benchmarks; VTK's Python reader checks the meshes pneumo writes (tests/test_vtu_vtk.cpp)
-  libgtest-dev googletest libbenchmark-dev python3-vtk9 python3-numpy
+  # tests and benchmarks; VTK's Python reader checks the meshes pneumo writes (tests/test_vtu_vtk.cpp),
+  # ITK applies the displacement field pneumo writes and nibabel reads it (tests/test_displacement_field.cpp)
+  libgtest-dev googletest libbenchmark-dev python3-vtk9 python3-numpy python3-nibabel libinsighttoolkit5-dev
 )
 if [ "${1:-}" = "--peers" ]; then
-  packages+=(python3-scipy libinsighttoolkit5-dev libglew-dev)
+  packages+=(python3-scipy libglew-dev)
 fi
 
 SUDO=""

@@ -19,6 +19,7 @@
 #include "report/slices.h"
 #include "roles/connected_components.h"
 #include "warp/cavity_specks.h"
+#include "warp/displacement_field.h"
 
 namespace pneumo {
 
@@ -136,7 +137,7 @@ WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labe
   // The working grid holds the mesh, so the deformed body too unless it rises beyond the padding.
   const bool working = scene.output.grid == OutputGrid::Working;
   w.output_grid = working ? w.roles.geometry : w.ct.geometry();
-  WarpBox box;
+  WarpBox& box = w.box;
   box.lo = working ? Index3{0, 0, 0} : w.roles.pad.lo;
   box.dims = w.output_grid.dims;
   WarpOptions opt;
@@ -320,6 +321,14 @@ void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir)
     const std::vector<LabelTableEntry> rows = deformed_label_entries(scene, w);
     write_slicer_colour_table(outputs.add("deformed_labels.ctbl"), rows);
     write_itksnap_label_description(outputs.add("deformed_labels_itksnap.txt"), rows);
+  }
+  if (scene.output.write_displacement_field) {
+    const DisplacementField f = pull_back_field(scene.device, w.warp_mesh, w.roles.role.data(), w.box, w.output_grid);
+    write_nifti_vectors(f.grid, f.u_lps_mm.data(), 3, outputs.add("displacement_field.nii.gz"), "LPS mm pullback");
+    char msg[160];
+    std::snprintf(msg, sizeof msg, "displacement field: %lld voxels carried, largest displacement %.1f mm",
+                  static_cast<long long>(f.carried_voxels), f.max_norm_mm);
+    log::info(msg);
   }
   if (scene.output.write_slices) {
     const Volume after = deformed_ct_volume(w);

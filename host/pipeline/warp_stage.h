@@ -29,6 +29,7 @@ struct WarpedCase {
   Deformation deformation;
   WarpMesh warp_mesh;
   WarpResult result;              // on output_grid
+  WarpBox box;                    // output_grid within the working grid
   Geometry output_grid;           // output.grid: the working grid or the CT's
   double outside_grid_mm = 0.0;   // how far the deformed mesh reaches beyond output_grid (0: inside)
   double voxel_volume_ml = 0.0;
@@ -88,7 +89,8 @@ Volume deformed_label_volume(const WarpedCase& w, int cavity_label);
 /// The keys the warp adds to metrics.json (see write_warp).
 nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w);
 
-/// Writes deformed_ct.nii.gz, deformed_labels.nii.gz (with a label map) and slices_before_after.png
+/// Writes deformed_ct.nii.gz, deformed_labels.nii.gz (with a label map), displacement_field.nii.gz and
+/// slices_before_after.png
 /// as the scene's output.write_* ask, then adds warp_metrics() to DIR/metrics.json: cavity_voxels
 /// and cavity_volume_ml become the warped cavity's, the mesh's own estimate stays as
 /// mesh_cavity_volume_ml. Every file is written atomically, metrics.json last.

@@ -107,6 +107,7 @@ struct SceneOutput {
   bool write_meshes = true;      // mesh_initial.vtu and mesh_deformed.vtu (compressed; ParaView, VTK, meshio)
   bool write_deformed_ct = true;
   bool write_deformed_labels = true;
+  bool write_displacement_field = false;   // displacement_field.nii.gz (warp/displacement_field.h)
   OutputGrid grid = OutputGrid::Working;
   // Label id of the CO2 cavity in the warped label map (§7). TotalSegmentator's ids end at 117 and
   // the phantom's own at 207; 250 is free in both. A label map that already uses it is refused.

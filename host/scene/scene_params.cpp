@@ -399,6 +399,10 @@ const Table<SceneOutput>& output_table() {
       {"write_deformed_ct", &SceneOutput::write_deformed_ct, "", any(), "Write the warped CT (§7)."},
       {"write_deformed_labels", &SceneOutput::write_deformed_labels, "", any(),
        "Write the warped label map (with the cavity label) when a label map is given (§7)."},
+      {"write_displacement_field", &SceneOutput::write_displacement_field, "", any(),
+       "Write the warp as a dense displacement field, displacement_field.nii.gz: a NIfTI vector image on the "
+       "output grid, float32 millimetres in ITK's LPS frame, pulling back (output(x) = input(x + u(x))), as "
+       "ITK's DisplacementFieldTransform, ANTs and 3D Slicer apply it to another image; zero in the cavity."},
       {"grid", &SceneOutput::grid, "", any(),
        "Grid of deformed_ct and deformed_labels: \"working\" = the CT grown by roles.pad_* (same spacing and "
        "direction; it holds the mesh, so a dome that rises out of the CT is not clipped), \"input\" = the CT's own."},
