@@ -7,6 +7,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -60,9 +61,11 @@ int check_complete(const fs::path& out) {
 
 TEST(KillDuringRun, WhatItLeavesIsWholeOrAbsentAndTheNextRunCleansUp) {
   // The tiny case made slow enough to be caught at work: the explicit solver over a 2 s ramp, and
-  // views large enough that rendering and writing them take a while. An uninterrupted run first
-  // measures how long a run takes here; the kills land at fractions of it, so they fall in the
-  // solve, in the warp and in the writing however fast the machine is.
+  // views large enough that rendering and writing them take a while. Uninterrupted runs first
+  // measure how long a run takes here; the kills land at fractions of it, so they fall in the
+  // solve, in the warp and in the writing however fast the machine is. The shorter of two runs is
+  // the measure: the first may be slowed by what it warms (kernel and file caches), and on a busy
+  // machine a slow measure would put the last kills after the killed runs had finished.
   ScratchDir d;
   nlohmann::json s = tiny_case_scene_json();
   s["solver"] = {{"method", "explicit"}};
@@ -70,12 +73,15 @@ TEST(KillDuringRun, WhatItLeavesIsWholeOrAbsentAndTheNextRunCleansUp) {
   s["render"]["width"] = 480;
   s["render"]["height"] = 360;
   const std::string scene = write_tiny_case(d, s);
-  const auto t0 = std::chrono::steady_clock::now();
-  ASSERT_EQ(run_pneumo("-q run " + scene + " --out " + d.file("control")).code, 0);
-  const double whole_run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("an uninterrupted run: %.2f s\n", whole_run_s);
+  double whole_run_s = 1e30;
+  for (int run = 0; run < 2; ++run) {
+    const auto t0 = std::chrono::steady_clock::now();
+    ASSERT_EQ(run_pneumo("-q run " + scene + " --out " + d.file("control") + " --force").code, 0);
+    whole_run_s = std::min(whole_run_s, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::printf("an uninterrupted run: %.2f s (the shorter of two)\n", whole_run_s);
   int index = 0, killed_running = 0;
-  for (const double fraction : {0.3, 0.6, 0.8, 0.95}) {
+  for (const double fraction : {0.25, 0.5, 0.7, 0.85}) {
     const double after_s = fraction * whole_run_s;
     SCOPED_TRACE("killed after " + std::to_string(after_s) + " s");
     const std::string out = d.file("out" + std::to_string(index++)), pid_file = d.file("pid");
