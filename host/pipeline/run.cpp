@@ -32,7 +32,8 @@ namespace fs = std::filesystem;
 /// removed before a forced run, so nothing stale sits beside the new results.
 const char* const kRunFiles[] = {"report.html",       "metrics.json",           "render.json",
                                  "deformed_ct.nii.gz", "deformed_labels.nii.gz", "deformed_labels.ctbl",
-                                 "deformed_labels_itksnap.txt", "displacement_field.nii.gz", "slices_before_after.png",
+                                 "deformed_labels_itksnap.txt", "displacement_field.nii.gz",
+                                 "displacement_field_transform.h5", "slices_before_after.png",
                                  "mesh_initial.vtu",  "mesh_deformed.vtu",      "deformation.bin",
                                  "convergence.csv",   "convergence.svg",        "pressure_volume.csv",
                                  "pressure_volume.svg", "scene_used.json",      "roles.png"};

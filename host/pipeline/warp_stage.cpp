@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/units.h"
+#include "io/itk_transform_io.h"
 #include "io/volume_io.h"
 #include "image/png.h"
 #include "pipeline/cavity_measures.h"
@@ -325,6 +326,7 @@ void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir)
   if (scene.output.write_displacement_field) {
     const DisplacementField f = pull_back_field(scene.device, w.warp_mesh, w.roles.role.data(), w.box, w.output_grid);
     write_nifti_vectors(f.grid, f.u_lps_mm.data(), 3, outputs.add("displacement_field.nii.gz"), "LPS mm pullback");
+    write_itk_displacement_field_transform(f.grid, f.u_lps_mm.data(), outputs.add("displacement_field_transform.h5"));
     char msg[160];
     std::snprintf(msg, sizeof msg, "displacement field: %lld voxels carried, largest displacement %.1f mm",
                   static_cast<long long>(f.carried_voxels), f.max_norm_mm);

@@ -402,7 +402,8 @@ const Table<SceneOutput>& output_table() {
       {"write_displacement_field", &SceneOutput::write_displacement_field, "", any(),
        "Write the warp as a dense displacement field, displacement_field.nii.gz: a NIfTI vector image on the "
        "output grid, float32 millimetres in ITK's LPS frame, pulling back (output(x) = input(x + u(x))), as "
-       "ITK's DisplacementFieldTransform, ANTs and 3D Slicer apply it to another image; zero in the cavity."},
+       "ITK's DisplacementFieldTransform, ANTs and 3D Slicer apply it to another image; zero in the cavity. "
+       "The same field as an ITK transform file, displacement_field_transform.h5, beside it."},
       {"grid", &SceneOutput::grid, "", any(),
        "Grid of deformed_ct and deformed_labels: \"working\" = the CT grown by roles.pad_* (same spacing and "
        "direction; it holds the mesh, so a dome that rises out of the CT is not clipped), \"input\" = the CT's own."},
