@@ -15,13 +15,14 @@ packages=(
   libegl-dev libgl-dev libopengl-dev libgles-dev libosmesa6-dev libegl-mesa0 mesa-utils
   # image output; ffmpeg (with ffprobe) encodes the fly-through and inflation-preview MP4s
   libstb-dev ffmpeg
-  # volume I/O; HDF5 writes the ITK transform file of the displacement field
-  libnifti2-dev zlib1g-dev libhdf5-dev
+  # volume I/O; HDF5 writes the ITK transform file of the displacement field, GDCM reads DICOM series
+  libnifti2-dev zlib1g-dev libhdf5-dev libgdcm-dev
   # CLI and scenes
   libcli11-dev nlohmann-json3-dev
   # tests and benchmarks; VTK's Python reader checks the meshes pneumo writes (tests/test_vtu_vtk.cpp),
-  # ITK applies the displacement field pneumo writes and nibabel reads it (tests/test_displacement_field.cpp)
-  libgtest-dev googletest libbenchmark-dev python3-vtk9 python3-numpy python3-nibabel libinsighttoolkit5-dev
+  # ITK applies the displacement field pneumo writes and nibabel reads it (tests/test_displacement_field.cpp),
+  # pydicom writes the DICOM series pneumo reads (tests/test_dicom_series.cpp)
+  libgtest-dev googletest libbenchmark-dev python3-vtk9 python3-numpy python3-nibabel python3-pydicom libinsighttoolkit5-dev
 )
 if [ "${1:-}" = "--peers" ]; then
   packages+=(python3-scipy libglew-dev)

@@ -5,6 +5,7 @@
 
 #include "core/error.h"
 #include "core/memory_budget.h"
+#include "io/dicom_io.h"
 
 namespace pneumo {
 
@@ -21,10 +22,15 @@ VolumeFormat volume_format_from_path(const std::string& path) {
   if (ends_with(path, ".nii")) return VolumeFormat::Nifti;
   if (ends_with(path, ".mha")) return VolumeFormat::MetaImageSingle;
   if (ends_with(path, ".mhd")) return VolumeFormat::MetaImageSplit;
-  throw file_error(path, "unknown volume format (expected .nii, .nii.gz, .mha or .mhd)");
+  throw file_error(path, "unknown volume format (expected .nii, .nii.gz, .mha, .mhd, or the folder of a DICOM series)");
 }
 
 Volume read_volume(const std::string& path) {
+  // A folder is a DICOM series unless its name is a volume file's (a folder "ct.mha" is a mistake
+  // the MetaImage reader names as such).
+  const bool file_name = ends_with(path, ".nii.gz") || ends_with(path, ".nii") || ends_with(path, ".mha") ||
+                         ends_with(path, ".mhd");
+  if (!file_name && is_dicom_series_folder(path)) return read_dicom_series(path);
   switch (volume_format_from_path(path)) {
     case VolumeFormat::Nifti:
     case VolumeFormat::NiftiGz: return read_nifti(path);

@@ -1,6 +1,6 @@
 #pragma once
 // Reading and writing volumes: NIfTI-1 (.nii, .nii.gz) and MetaImage (.mha, .mhd + raw), chosen by
-// the file name. Every reader checks a header against the file before allocating what it promises,
+// the file name, and a DICOM CT series read from its folder (io/dicom_io.h). Every reader checks a header against the file before allocating what it promises,
 // and reports any problem as an InputError naming the file. Every writer is atomic.
 #include <string>
 
@@ -13,7 +13,7 @@ enum class VolumeFormat { Nifti, NiftiGz, MetaImageSingle, MetaImageSplit };
 /// The format implied by the file name; throws InputError for an unknown extension.
 VolumeFormat volume_format_from_path(const std::string& path);
 
-/// Reads a volume. Scaled integer data (NIfTI scl_slope/scl_inter other than 1/0) is returned as
+/// Reads a volume: a folder as a DICOM CT series (float32 HU), a file by its name. Scaled integer data (NIfTI scl_slope/scl_inter other than 1/0) is returned as
 /// float32 with the scaling applied (float64 where float32 would round the source type).
 Volume read_volume(const std::string& path);
 

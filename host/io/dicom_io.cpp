@@ -1,0 +1,222 @@
+#include "io/dicom_io.h"
+
+#include <gdcmDirectory.h>
+#include <gdcmImage.h>
+#include <gdcmImageReader.h>
+#include <gdcmPixelFormat.h>
+#include <gdcmScanner.h>
+#include <gdcmTag.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "core/error.h"
+#include "io/volume_io.h"
+
+namespace pneumo {
+namespace {
+
+const gdcm::Tag kModality(0x0008, 0x0060), kSeriesUid(0x0020, 0x000e), kPosition(0x0020, 0x0032),
+    kOrientation(0x0020, 0x0037), kRows(0x0028, 0x0010), kColumns(0x0028, 0x0011), kPixelSpacing(0x0028, 0x0030),
+    kFrames(0x0028, 0x0008);
+
+std::string trimmed(const char* s) {
+  std::string t = s ? s : "";
+  while (!t.empty() && (t.back() == ' ' || t.back() == '\0')) t.pop_back();
+  while (!t.empty() && t.front() == ' ') t.erase(t.begin());
+  return t;
+}
+
+/// A decimal-string value of `n` numbers separated by backslashes (DICOM PS3.5 §6.2, DS).
+std::vector<double> numbers(const std::string& dir, const std::string& file, const char* value, std::size_t n,
+                            const char* what) {
+  std::vector<double> out;
+  std::stringstream ss(trimmed(value));
+  std::string item;
+  bool ok = true;
+  while (ok && std::getline(ss, item, '\\')) {
+    try {
+      std::size_t used = 0;
+      out.push_back(std::stod(item, &used));
+      ok = trimmed(item.substr(used).c_str()).empty();
+    } catch (const std::exception&) {
+      ok = false;
+    }
+  }
+  if (!ok) out.clear();
+  if (out.size() != n || !std::all_of(out.begin(), out.end(), [](double v) { return std::isfinite(v); }))
+    throw file_error(dir, std::string(what) + " of " + file + " is \"" + trimmed(value) + "\", not " +
+                              std::to_string(n) + " numbers");
+  return out;
+}
+
+struct Slice {
+  std::string file;
+  Vec3 position_lps;
+  double along_normal = 0.0;
+};
+
+std::string name_of(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
+}  // namespace
+
+bool is_dicom_series_folder(const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::is_directory(path, ec);
+}
+
+Volume read_dicom_series(const std::string& dir) {
+  if (!is_dicom_series_folder(dir)) throw file_error(dir, "not a folder (a DICOM series is read from its folder)");
+  gdcm::Directory listing;
+  listing.Load(dir, false);
+  gdcm::Scanner scanner;
+  for (const gdcm::Tag& t : {kModality, kSeriesUid, kPosition, kOrientation, kRows, kColumns, kPixelSpacing, kFrames})
+    scanner.AddTag(t);
+  if (!scanner.Scan(listing.GetFilenames())) throw file_error(dir, "cannot scan the folder's files for DICOM");
+
+  std::vector<std::string> files;
+  std::set<std::string> series;
+  for (const std::string& f : listing.GetFilenames()) {
+    if (!scanner.IsKey(f.c_str())) continue;   // not DICOM: a DICOMDIR's neighbours, notes, thumbnails
+    files.push_back(f);
+    series.insert(trimmed(scanner.GetValue(f.c_str(), kSeriesUid)));
+  }
+  if (files.empty()) throw file_error(dir, "holds no DICOM file (give the folder of one CT series)");
+  if (series.size() > 1)
+    throw file_error(dir, "holds " + std::to_string(series.size()) +
+                              " series (Series Instance UID): give the folder of one CT series");
+
+  // The geometry every slice must share: the first file's, checked against each other's.
+  const std::string& first = files.front();
+  auto value = [&](const std::string& f, const gdcm::Tag& t) { return scanner.GetValue(f.c_str(), t); };
+  std::vector<Slice> slices;
+  std::vector<double> orientation, spacing;
+  std::string rows, columns;
+  for (const std::string& f : files) {
+    const std::string modality = trimmed(value(f, kModality));
+    if (modality != "CT")
+      throw file_error(dir, name_of(f) + " is modality \"" + modality + "\": pneumo needs a CT series (HU)");
+    if (!trimmed(value(f, kFrames)).empty() && trimmed(value(f, kFrames)) != "1")
+      throw file_error(dir, name_of(f) + " is a multi-frame image (" + trimmed(value(f, kFrames)) +
+                                " frames): export the series as one file per slice");
+    if (!value(f, kPosition) || !value(f, kOrientation) || !value(f, kPixelSpacing))
+      throw file_error(dir, name_of(f) + " lacks Image Position, Image Orientation or Pixel Spacing (Patient)");
+    const std::vector<double> o = numbers(dir, name_of(f), value(f, kOrientation), 6, "Image Orientation (Patient)");
+    const std::vector<double> s = numbers(dir, name_of(f), value(f, kPixelSpacing), 2, "Pixel Spacing");
+    const std::vector<double> p = numbers(dir, name_of(f), value(f, kPosition), 3, "Image Position (Patient)");
+    if (f == first) {
+      orientation = o, spacing = s, rows = trimmed(value(f, kRows)), columns = trimmed(value(f, kColumns));
+    } else {
+      for (int c = 0; c < 6; ++c)
+        if (std::abs(o[std::size_t(c)] - orientation[std::size_t(c)]) > 1e-4)
+          throw file_error(dir, name_of(f) + " has another orientation than " + name_of(first) +
+                                    ": not one volume");
+      for (int c = 0; c < 2; ++c)
+        if (std::abs(s[std::size_t(c)] - spacing[std::size_t(c)]) > 1e-4 * spacing[std::size_t(c)])
+          throw file_error(dir, name_of(f) + " has another pixel spacing than " + name_of(first) + ": not one volume");
+      if (trimmed(value(f, kRows)) != rows || trimmed(value(f, kColumns)) != columns)
+        throw file_error(dir, name_of(f) + " has another image size than " + name_of(first) + ": not one volume");
+    }
+    slices.push_back({f, Vec3(p[0], p[1], p[2]), 0.0});
+  }
+  if (slices.size() < 2) throw file_error(dir, "holds one slice: a volume needs at least two");
+  if (!(spacing[0] > 0.0 && spacing[1] > 0.0)) throw file_error(dir, "Pixel Spacing is not positive");
+
+  // The frame (PS3.3 C.7.6.2.1.1): the first three of the orientation are the direction of a row,
+  // along which the column index (pneumo's i) grows; the last three the direction down a column (j).
+  Vec3 along_row(orientation[0], orientation[1], orientation[2]), along_column(orientation[3], orientation[4],
+                                                                                orientation[5]);
+  if (std::abs(along_row.norm() - 1.0) > 1e-3 || std::abs(along_column.norm() - 1.0) > 1e-3 ||
+      std::abs(along_row.dot(along_column)) > 1e-3)
+    throw file_error(dir, "Image Orientation (Patient) is not two orthonormal directions");
+  along_row.normalize();
+  along_column = (along_column - along_row.dot(along_column) * along_row).normalized();
+  const Vec3 normal = along_row.cross(along_column);
+  for (Slice& s : slices) s.along_normal = s.position_lps.dot(normal);
+  std::sort(slices.begin(), slices.end(), [](const Slice& a, const Slice& b) { return a.along_normal < b.along_normal; });
+
+  // Even gaps along the normal, and positions on the normal (no gantry tilt, no shear).
+  const std::size_t n_slices = slices.size();
+  const double gap = (slices.back().along_normal - slices.front().along_normal) / double(n_slices - 1);
+  for (std::size_t s = 1; s < n_slices; ++s) {
+    const double step = slices[s].along_normal - slices[s - 1].along_normal;
+    if (step < 1e-3)
+      throw file_error(dir, name_of(slices[s - 1].file) + " and " + name_of(slices[s].file) +
+                                " lie at one position: two acquisitions in one series?");
+    if (std::abs(step - gap) > 0.01 * gap + 1e-3) {
+      std::ostringstream os;
+      os << "slices are not evenly spaced: " << step << " mm between " << name_of(slices[s - 1].file) << " and "
+         << name_of(slices[s].file) << " where the series averages " << gap << " mm (a missing slice?)";
+      throw file_error(dir, os.str());
+    }
+    const Vec3 offset = slices[s].position_lps - slices[s - 1].position_lps;
+    if ((offset - step * normal).norm() > 0.01 * gap + 1e-3)
+      throw file_error(dir, "slice positions are not along the slice normal (a tilted gantry): resample the series "
+                            "to a tilt-free one first");
+  }
+
+  // pneumo's grid in world RAS: DICOM's LPS with x and y turned.
+  const Mat3 lps_to_ras = Vec3(-1.0, -1.0, 1.0).asDiagonal();
+  Geometry g;
+  g.dims = {std::stoll(columns), std::stoll(rows), int64_t(n_slices)};
+  g.spacing_mm = Vec3(spacing[1], spacing[0], gap);   // Pixel Spacing is (between rows, between columns)
+  g.origin_mm = lps_to_ras * slices.front().position_lps;
+  g.direction.col(0) = lps_to_ras * along_row;
+  g.direction.col(1) = lps_to_ras * along_column;
+  g.direction.col(2) = lps_to_ras * normal;
+  if (g.dims[0] < 1 || g.dims[1] < 1) throw file_error(dir, "Rows or Columns is not a positive number");
+  require_volume_memory(dir, g, VoxelType::Float32);
+
+  Volume v(g, VoxelType::Float32);
+  float* out = v.data<float>();
+  const std::size_t per_slice = std::size_t(g.dims[0] * g.dims[1]);
+  std::vector<char> buffer;
+  for (std::size_t s = 0; s < n_slices; ++s) {
+    gdcm::ImageReader reader;
+    reader.SetFileName(slices[s].file.c_str());
+    if (!reader.Read()) throw file_error(dir, name_of(slices[s].file) + ": GDCM cannot read its image");
+    const gdcm::Image& image = reader.GetImage();
+    const gdcm::PixelFormat& pf = image.GetPixelFormat();
+    if (pf.GetSamplesPerPixel() != 1 ||
+        image.GetPhotometricInterpretation() != gdcm::PhotometricInterpretation::MONOCHROME2)
+      throw file_error(dir, name_of(slices[s].file) + " is not a greyscale (MONOCHROME2) image");
+    if (image.GetDimension(0) != unsigned(g.dims[0]) || image.GetDimension(1) != unsigned(g.dims[1]))
+      throw file_error(dir, name_of(slices[s].file) + ": its pixel data is not Rows × Columns");
+    buffer.resize(image.GetBufferLength());
+    if (!image.GetBuffer(buffer.data())) throw file_error(dir, name_of(slices[s].file) + ": cannot decode its pixels");
+    const double slope = image.GetSlope(), intercept = image.GetIntercept();
+    if (!(std::isfinite(slope) && std::isfinite(intercept) && slope != 0.0))
+      throw file_error(dir, name_of(slices[s].file) + ": Rescale Slope or Intercept is not a usable number");
+    float* dst = out + s * per_slice;
+    auto convert = [&](auto sample) {
+      using T = decltype(sample);
+      if (buffer.size() < per_slice * sizeof(T))
+        throw file_error(dir, name_of(slices[s].file) + ": its pixel data is shorter than Rows × Columns");
+      for (std::size_t n = 0; n < per_slice; ++n) {
+        T raw;
+        std::memcpy(&raw, buffer.data() + n * sizeof(T), sizeof(T));
+        dst[n] = float(slope * double(raw) + intercept);
+      }
+    };
+    switch (pf.GetScalarType()) {
+      case gdcm::PixelFormat::UINT8: convert(uint8_t{}); break;
+      case gdcm::PixelFormat::INT8: convert(int8_t{}); break;
+      case gdcm::PixelFormat::UINT16: convert(uint16_t{}); break;
+      case gdcm::PixelFormat::INT16: convert(int16_t{}); break;
+      case gdcm::PixelFormat::UINT32: convert(uint32_t{}); break;
+      case gdcm::PixelFormat::INT32: convert(int32_t{}); break;
+      default:
+        throw file_error(dir, name_of(slices[s].file) + ": pixel type " + pf.GetScalarTypeAsString() +
+                                  " is not an integer CT's");
+    }
+  }
+  return v;
+}
+
+}  // namespace pneumo
