@@ -15,8 +15,9 @@ packages=(
   libegl-dev libgl-dev libopengl-dev libgles-dev libosmesa6-dev libegl-mesa0 mesa-utils
   # image output; ffmpeg (with ffprobe) encodes the fly-through and inflation-preview MP4s
   libstb-dev ffmpeg
-  # volume I/O; HDF5 writes the ITK transform file of the displacement field, GDCM reads DICOM series
-  libnifti2-dev zlib1g-dev libhdf5-dev libgdcm-dev
+  # volume I/O; HDF5 writes the ITK transform file of the displacement field, GDCM reads DICOM
+  # series, teem reads and writes NRRD
+  libnifti2-dev zlib1g-dev libhdf5-dev libgdcm-dev libteem-dev
   # CLI and scenes
   libcli11-dev nlohmann-json3-dev
   # tests and benchmarks; VTK's Python reader checks the meshes pneumo writes (tests/test_vtu_vtk.cpp),

@@ -12,7 +12,7 @@ Run add_info(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "Describe a volume: grid, world geometry, voxel type, values, labels");
   auto path = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);
-  cmd->add_option("file", *path, "A .nii, .nii.gz, .mha or .mhd volume, or the folder of a DICOM CT series")->required();
+  cmd->add_option("file", *path, "A .nii, .nii.gz, .mha, .mhd, .nrrd or .nhdr volume, or the folder of a DICOM CT series")->required();
   cmd->add_flag("--json", *json, "Print JSON (keys dims, spacing_mm, origin_mm, direction, orientation, ...)");
   return [=] {
     const Volume v = read_volume(*path);

@@ -9,6 +9,7 @@ namespace pneumo::cli {
 using Run = std::function<int()>;   // returns the exit code
 
 Run add_info(CLI::App& app);
+Run add_convert(CLI::App& app);
 Run add_devices(CLI::App& app);
 Run add_phantom(CLI::App& app);
 Run add_scene(CLI::App& app);

@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
     commands.emplace_back(sub, std::move(run));
   };
   add(cli::add_info);
+  add(cli::add_convert);
   add(cli::add_devices);
   add(cli::add_phantom);
   add(cli::add_scene);

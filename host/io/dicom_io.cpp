@@ -164,13 +164,22 @@ Volume read_dicom_series(const std::string& dir) {
   // pneumo's grid in world RAS: DICOM's LPS with x and y turned.
   const Mat3 lps_to_ras = Vec3(-1.0, -1.0, 1.0).asDiagonal();
   Geometry g;
-  g.dims = {std::stoll(columns), std::stoll(rows), int64_t(n_slices)};
+  const auto count = [&](const std::string& text, const char* what) {
+    try {
+      std::size_t used = 0;
+      const long long n = std::stoll(text, &used);
+      if (used == text.size() && n > 0) return int64_t(n);
+    } catch (const std::exception&) {
+    }
+    throw file_error(dir, std::string(what) + " is \"" + text + "\", not a positive number");
+  };
+  g.dims = {count(columns, "Columns"), count(rows, "Rows"), int64_t(n_slices)};
   g.spacing_mm = Vec3(spacing[1], spacing[0], gap);   // Pixel Spacing is (between rows, between columns)
   g.origin_mm = lps_to_ras * slices.front().position_lps;
   g.direction.col(0) = lps_to_ras * along_row;
   g.direction.col(1) = lps_to_ras * along_column;
   g.direction.col(2) = lps_to_ras * normal;
-  if (g.dims[0] < 1 || g.dims[1] < 1) throw file_error(dir, "Rows or Columns is not a positive number");
+  g.validate(dir);
   require_volume_memory(dir, g, VoxelType::Float32);
 
   Volume v(g, VoxelType::Float32);

@@ -6,6 +6,7 @@
 #include "core/error.h"
 #include "core/memory_budget.h"
 #include "io/dicom_io.h"
+#include "io/nrrd_io.h"
 
 namespace pneumo {
 
@@ -22,20 +23,25 @@ VolumeFormat volume_format_from_path(const std::string& path) {
   if (ends_with(path, ".nii")) return VolumeFormat::Nifti;
   if (ends_with(path, ".mha")) return VolumeFormat::MetaImageSingle;
   if (ends_with(path, ".mhd")) return VolumeFormat::MetaImageSplit;
-  throw file_error(path, "unknown volume format (expected .nii, .nii.gz, .mha, .mhd, or the folder of a DICOM series)");
+  if (ends_with(path, ".nrrd")) return VolumeFormat::Nrrd;
+  if (ends_with(path, ".nhdr")) return VolumeFormat::NrrdDetached;
+  throw file_error(path,
+                   "unknown volume format (expected .nii, .nii.gz, .mha, .mhd, .nrrd, .nhdr, or the folder of a DICOM series)");
 }
 
 Volume read_volume(const std::string& path) {
   // A folder is a DICOM series unless its name is a volume file's (a folder "ct.mha" is a mistake
   // the MetaImage reader names as such).
   const bool file_name = ends_with(path, ".nii.gz") || ends_with(path, ".nii") || ends_with(path, ".mha") ||
-                         ends_with(path, ".mhd");
+                         ends_with(path, ".mhd") || ends_with(path, ".nrrd") || ends_with(path, ".nhdr");
   if (!file_name && is_dicom_series_folder(path)) return read_dicom_series(path);
   switch (volume_format_from_path(path)) {
     case VolumeFormat::Nifti:
     case VolumeFormat::NiftiGz: return read_nifti(path);
     case VolumeFormat::MetaImageSingle:
     case VolumeFormat::MetaImageSplit: return read_metaimage(path);
+    case VolumeFormat::Nrrd:
+    case VolumeFormat::NrrdDetached: return read_nrrd(path);
   }
   throw file_error(path, "unknown volume format");
 }
@@ -46,6 +52,9 @@ void write_volume(const Volume& v, const std::string& path, const WriteOptions& 
     case VolumeFormat::NiftiGz: return write_nifti(v, path);
     case VolumeFormat::MetaImageSingle:
     case VolumeFormat::MetaImageSplit: return write_metaimage(v, path, opt.compress_metaimage);
+    case VolumeFormat::Nrrd: return write_nrrd(v, path);
+    case VolumeFormat::NrrdDetached:
+      throw file_error(path, "pneumo writes NRRD as one file: name it .nrrd (a detached .nhdr is read, not written)");
   }
 }
 

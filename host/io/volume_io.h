@@ -1,6 +1,7 @@
 #pragma once
-// Reading and writing volumes: NIfTI-1 (.nii, .nii.gz) and MetaImage (.mha, .mhd + raw), chosen by
-// the file name, and a DICOM CT series read from its folder (io/dicom_io.h). Every reader checks a header against the file before allocating what it promises,
+// Reading and writing volumes: NIfTI-1 (.nii, .nii.gz), MetaImage (.mha, .mhd + raw) and NRRD (.nrrd;
+// .nhdr + data, read only; io/nrrd_io.h), chosen by the file name, and a DICOM CT series read from
+// its folder (io/dicom_io.h). Every reader checks a header against the file before allocating what it promises,
 // and reports any problem as an InputError naming the file. Every writer is atomic.
 #include <string>
 
@@ -8,7 +9,7 @@
 
 namespace pneumo {
 
-enum class VolumeFormat { Nifti, NiftiGz, MetaImageSingle, MetaImageSplit };
+enum class VolumeFormat { Nifti, NiftiGz, MetaImageSingle, MetaImageSplit, Nrrd, NrrdDetached };
 
 /// The format implied by the file name; throws InputError for an unknown extension.
 VolumeFormat volume_format_from_path(const std::string& path);

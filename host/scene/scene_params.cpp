@@ -84,7 +84,7 @@ bool is_pressure_curve(const json& v) {
 const Table<SceneInputs>& inputs_table() {
   static const Table<SceneInputs> t{
       {"ct", &SceneInputs::ct, "", file_path(),
-       "CT volume (.nii, .nii.gz, .mha, .mhd), or the folder of one DICOM CT series. Unset is accepted here; "
+       "CT volume (.nii, .nii.gz, .mha, .mhd, .nrrd, .nhdr), or the folder of one DICOM CT series. Unset is accepted here; "
        "commands that need a CT say so."},
       {"labels", &SceneInputs::labels, "", file_path(),
        "Label map on the CT's voxel grid (integer ids): roles and organ colours."},

@@ -1,0 +1,185 @@
+#include "io/nrrd_io.h"
+
+#include <teem/nrrd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <sys/stat.h>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "io/volume_io.h"
+
+namespace pneumo {
+namespace {
+
+/// teem's error (its biff stack) as one line, and the stack cleared.
+std::string teem_error() {
+  char* text = biffGetDone(NRRD);
+  std::string s = text ? text : "unknown error";
+  std::free(text);
+  // The stack is innermost last, one message per line: the last line says what was wrong.
+  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+  const std::size_t last = s.rfind('\n');
+  if (last != std::string::npos) s = s.substr(last + 1);
+  const std::size_t bracket = s.find("] ");
+  if (bracket != std::string::npos && s[0] == '[') s = s.substr(bracket + 2);
+  // and teem's function name before the message ("_nrrdHeaderCheck: ...") means nothing to a user.
+  const std::size_t colon = s.find(": ");
+  if (colon != std::string::npos && s.find(' ') == colon + 1) s = s.substr(colon + 2);
+  return s;
+}
+
+struct NrrdFree {
+  void operator()(Nrrd* n) const { nrrdNuke(n); }
+};
+struct IoFree {
+  void operator()(NrrdIoState* n) const { nrrdIoStateNix(n); }
+};
+using NrrdPtr = std::unique_ptr<Nrrd, NrrdFree>;
+using IoPtr = std::unique_ptr<NrrdIoState, IoFree>;
+
+VoxelType voxel_type_of_nrrd(const std::string& path, int type) {
+  switch (type) {
+    case nrrdTypeChar: return VoxelType::Int8;
+    case nrrdTypeUChar: return VoxelType::UInt8;
+    case nrrdTypeShort: return VoxelType::Int16;
+    case nrrdTypeUShort: return VoxelType::UInt16;
+    case nrrdTypeInt: return VoxelType::Int32;
+    case nrrdTypeUInt: return VoxelType::UInt32;
+    case nrrdTypeFloat: return VoxelType::Float32;
+    case nrrdTypeDouble: return VoxelType::Float64;
+    default: throw file_error(path, std::string("voxel type ") + airEnumStr(nrrdType, type) + " is not supported");
+  }
+}
+
+int nrrd_type_of(VoxelType t) {
+  switch (t) {
+    case VoxelType::Int8: return nrrdTypeChar;
+    case VoxelType::UInt8: return nrrdTypeUChar;
+    case VoxelType::Int16: return nrrdTypeShort;
+    case VoxelType::UInt16: return nrrdTypeUShort;
+    case VoxelType::Int32: return nrrdTypeInt;
+    case VoxelType::UInt32: return nrrdTypeUInt;
+    case VoxelType::Float32: return nrrdTypeFloat;
+    case VoxelType::Float64: return nrrdTypeDouble;
+  }
+  return nrrdTypeUnknown;
+}
+
+/// The flip from the file's patient space to RAS (each space is RAS with some axes reversed).
+Vec3 to_ras_signs(const std::string& path, int space) {
+  switch (space) {
+    case nrrdSpaceRightAnteriorSuperior: return Vec3(1, 1, 1);
+    case nrrdSpaceLeftAnteriorSuperior: return Vec3(-1, 1, 1);
+    case nrrdSpaceLeftPosteriorSuperior:
+    case nrrdSpaceScannerXYZ: return Vec3(-1, -1, 1);   // scanner-xyz is LPS for a supine patient (teem, DICOM)
+    case nrrdSpaceUnknown:
+      throw file_error(path, "has no \"space\": where it lies in the patient is unknown (3D Slicer writes "
+                             "\"space: left-posterior-superior\" with \"space directions\" and \"space origin\")");
+    default:
+      throw file_error(path, std::string("space \"") + airEnumStr(nrrdSpace, space) +
+                                 "\" is not patient-oriented: use right-anterior-superior, left-anterior-superior "
+                                 "or left-posterior-superior");
+  }
+}
+
+/// The grid the header promises; throws InputError for what is not a placed 3D volume.
+Geometry geometry_of(const std::string& path, const Nrrd& n) {
+  if (n.dim != 3)
+    throw file_error(path, std::to_string(n.dim) + " dimensions: pneumo reads three-dimensional scalar volumes");
+  const Vec3 sign = to_ras_signs(path, n.space);
+  if (n.spaceDim != 3) throw file_error(path, "its space is not three-dimensional");
+  Geometry g;
+  for (int a = 0; a < 3; ++a) {
+    const NrrdAxisInfo& axis = n.axis[a];
+    if (axis.size > (size_t(1) << 40)) throw file_error(path, "axis " + std::to_string(a) + " is absurdly long");
+    g.dims[a] = int64_t(axis.size);
+    Vec3 d(axis.spaceDirection[0], axis.spaceDirection[1], axis.spaceDirection[2]);
+    if (!d.allFinite())
+      throw file_error(path, "axis " + std::to_string(a) + " has no space direction (a non-spatial axis?)");
+    g.spacing_mm[a] = d.norm();
+    if (!(g.spacing_mm[a] > 0.0)) throw file_error(path, "axis " + std::to_string(a) + " has a zero space direction");
+    g.direction.col(a) = sign.asDiagonal() * (d / g.spacing_mm[a]);
+  }
+  const Vec3 origin(n.spaceOrigin[0], n.spaceOrigin[1], n.spaceOrigin[2]);
+  if (!origin.allFinite()) throw file_error(path, "has no \"space origin\": where it lies in the patient is unknown");
+  g.origin_mm = sign.asDiagonal() * origin;
+  g.validate(path);
+  return g;
+}
+
+void require_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) throw file_error(path, "does not exist or cannot be read");
+  if (S_ISDIR(st.st_mode)) throw file_error(path, "is a folder, not a file");
+}
+
+}  // namespace
+
+Volume read_nrrd(const std::string& path) {
+  require_file(path);
+  // The header first (teem reads no voxels with skipData): what it promises is checked before any
+  // allocation, as every reader here does.
+  Geometry g;
+  VoxelType type;
+  {
+    NrrdPtr header(nrrdNew());
+    IoPtr io(nrrdIoStateNew());
+    io->skipData = AIR_TRUE;
+    if (nrrdLoad(header.get(), path.c_str(), io.get()) != 0) throw file_error(path, "not a readable NRRD: " + teem_error());
+    type = voxel_type_of_nrrd(path, header->type);
+    g = geometry_of(path, *header);
+  }
+  const int64_t dims[3] = {g.dims[0], g.dims[1], g.dims[2]};
+  checked_payload_bytes(path, dims, voxel_size(type));
+  require_volume_memory(path, g, type);
+
+  NrrdPtr n(nrrdNew());
+  if (nrrdLoad(n.get(), path.c_str(), nullptr) != 0) throw file_error(path, "not a readable NRRD: " + teem_error());
+  if (voxel_type_of_nrrd(path, n->type) != type || n->dim != 3 || !geometry_of(path, *n).same_grid(g, 0.0))
+    throw file_error(path, "changed while it was read");
+  Volume v(g, type);
+  std::memcpy(v.raw(), n->data, v.byte_count());   // teem gives host byte order, axis 0 fastest, as Volume
+  return v;
+}
+
+void write_nrrd(const Volume& v, const std::string& path) {
+  check_writable_target(path);
+  if (volume_format_from_path(path) != VolumeFormat::Nrrd)
+    throw file_error(path, "not a single-file NRRD name (expected .nrrd)");
+  const Geometry& g = v.geometry();
+  g.validate(path);
+  const Vec3 to_lps(-1.0, -1.0, 1.0);
+  double directions[NRRD_DIM_MAX][NRRD_SPACE_DIM_MAX];
+  for (int a = 0; a < 3; ++a) {
+    const Vec3 d = to_lps.asDiagonal() * (g.direction.col(a) * g.spacing_mm[a]);
+    for (int c = 0; c < 3; ++c) directions[a][c] = d[c] + 0.0;   // + 0.0: no "-0" in the header
+  }
+  const Vec3 origin = to_lps.asDiagonal() * g.origin_mm;
+  const int kinds[3] = {nrrdKindDomain, nrrdKindDomain, nrrdKindDomain};
+  const size_t sizes[3] = {size_t(g.dims[0]), size_t(g.dims[1]), size_t(g.dims[2])};
+
+  AtomicFile out(path);
+  // teem only reads the buffer it wraps; nrrdNix frees the wrapper, not the volume's voxels.
+  struct NixOnly {
+    void operator()(Nrrd* n) const { nrrdNix(n); }
+  };
+  std::unique_ptr<Nrrd, NixOnly> n(nrrdNew());
+  if (nrrdWrap_nva(n.get(), const_cast<void*>(v.raw()), nrrd_type_of(v.type()), 3, sizes) != 0 ||
+      nrrdSpaceSet(n.get(), nrrdSpaceLeftPosteriorSuperior) != 0 || nrrdSpaceOriginSet(n.get(), origin.data()) != 0)
+    throw std::runtime_error(path + ": cannot describe the volume to teem: " + teem_error());
+  nrrdAxisInfoSet_nva(n.get(), nrrdAxisInfoSpaceDirection, directions);
+  nrrdAxisInfoSet_nva(n.get(), nrrdAxisInfoKind, kinds);
+  IoPtr io(nrrdIoStateNew());
+  io->encoding = nrrdEncodingGzip;
+  io->zlibLevel = 1;   // fast: a CT's air and soft tissue compress well at any level
+  io->format = nrrdFormatNRRD;
+  if (nrrdSave(out.temp_path().c_str(), n.get(), io.get()) != 0)
+    throw std::runtime_error(path + ": cannot write: " + teem_error());
+  out.commit();
+}
+
+}  // namespace pneumo
