@@ -113,7 +113,7 @@ TEST(Nrrd, WhatIsNotOnePlacedVolumeIsRefusedSayingWhy) {
       {"truncated.nrrd",
        "NRRD0004\ntype: short\ndimension: 3\nspace: left-posterior-superior\nsizes: 2 2 9\n"
        "space directions: (1,0,0) (0,1,0) (0,0,1)\nspace origin: (0,0,0)\nendian: little\nencoding: raw\n\n",
-       "not a readable NRRD"},
+       "truncated"},
       {"absurd.nrrd",
        "NRRD0004\ntype: short\ndimension: 3\nspace: left-posterior-superior\nsizes: 1048576 1048576 1048576\n"
        "space directions: (1,0,0) (0,1,0) (0,0,1)\nspace origin: (0,0,0)\nendian: little\nencoding: raw\n\n",

@@ -3,8 +3,12 @@
 #include <teem/nrrd.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <memory>
 #include <sys/stat.h>
 
@@ -111,6 +115,31 @@ Geometry geometry_of(const std::string& path, const Nrrd& n) {
   return g;
 }
 
+/// Bytes after the attached header: NRRD's header ends at its first empty line.
+uint64_t attached_data_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  uint64_t header = 0;
+  while (std::getline(in, line)) {
+    header += line.size() + 1;
+    if (line.empty() || line == "\r") break;
+  }
+  const uint64_t total = uint64_t(std::filesystem::file_size(path));
+  return total > header ? total - header : 0;
+}
+
+/// The most voxel bytes `available` bytes of `encoding` can hold, so a header whose sizes promise
+/// more is refused before teem allocates them: deflate expands at most 1032:1 (zlib's technical
+/// note), hex takes two characters a byte, ASCII at least two a value (a digit and a separator).
+/// bzip2 has no useful bound; its files rely on the memory check alone.
+uint64_t most_voxel_bytes(const std::string& encoding, uint64_t available, std::size_t value_bytes) {
+  if (encoding == "raw") return available;
+  if (encoding == "gzip") return available > (UINT64_MAX - 1024) / 1032 ? UINT64_MAX : available * 1032 + 1024;
+  if (encoding == "hex") return available / 2;
+  if (encoding == "ascii") return (available / 2 + 1) * value_bytes;
+  return UINT64_MAX;
+}
+
 void require_file(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) throw file_error(path, "does not exist or cannot be read");
@@ -132,9 +161,32 @@ Volume read_nrrd(const std::string& path) {
     if (nrrdLoad(header.get(), path.c_str(), io.get()) != 0) throw file_error(path, "not a readable NRRD: " + teem_error());
     type = voxel_type_of_nrrd(path, header->type);
     g = geometry_of(path, *header);
+    const int64_t dims[3] = {g.dims[0], g.dims[1], g.dims[2]};
+    const uint64_t payload = checked_payload_bytes(path, dims, voxel_size(type));
+    // What the file (or the detached header's data files) holds, against what the sizes promise.
+    uint64_t available = 0;
+    if (io->dataFNArr->len == 0) {
+      available = attached_data_bytes(path);
+    } else {
+      const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+      for (unsigned int f = 0; f < io->dataFNArr->len; ++f) {
+        const std::filesystem::path data = std::filesystem::path(io->dataFN[f]).is_absolute()
+                                               ? std::filesystem::path(io->dataFN[f])
+                                               : folder / io->dataFN[f];
+        std::error_code ec;
+        const auto bytes = std::filesystem::file_size(data, ec);
+        if (ec) throw file_error(path, "its data file " + data.string() + " cannot be read");
+        available += uint64_t(bytes);
+      }
+    }
+    const std::string encoding = io->encoding ? io->encoding->name : "raw";
+    if (most_voxel_bytes(encoding, available, voxel_size(type)) < payload) {
+      std::ostringstream os;
+      os << "holds " << available << " bytes of " << encoding << " data where its sizes promise " << payload
+         << " bytes of voxels: truncated, or the sizes are wrong";
+      throw file_error(path, os.str());
+    }
   }
-  const int64_t dims[3] = {g.dims[0], g.dims[1], g.dims[2]};
-  checked_payload_bytes(path, dims, voxel_size(type));
   require_volume_memory(path, g, type);
 
   NrrdPtr n(nrrdNew());
