@@ -1,7 +1,8 @@
 #pragma once
 // A generator of volume files whose headers promise sizes that are zero, negative, overflowing or
 // absurd, in every format pneumo reads (NIfTI-1, plain and gzip; MetaImage with local, compressed
-// and separate data; NIfTI-2 is refused by its magic before any size is read), each with a payload of a few bytes. The hand-written cases of
+// and separate data; NRRD raw, gzip and with a detached header; NIfTI-2 is refused by its magic
+// before any size is read), each with a payload of a few bytes. The hand-written cases of
 // test_io_bad_input.cpp each hit one check; this crosses every size with every format and voxel
 // type, so a reader added later (NRRD, DICOM) is held to the same by adding its writer here.
 // Used by test_hostile_headers.cpp and by the fuzzers' seed corpus (fuzz/make_seeds.cpp).
@@ -46,14 +47,15 @@ inline std::vector<std::array<int64_t, 3>> hostile_dims() {
   return out;
 }
 
-/// The voxel types, as NIfTI codes with their bits and MetaImage names.
+/// The voxel types, as NIfTI codes with their bits, MetaImage and NRRD names.
 struct HostileType {
   short nifti_code, bits;
   const char* meta_name;
+  const char* nrrd_name;
 };
 inline std::vector<HostileType> hostile_types() {
-  return {{DT_UINT8, 8, "MET_UCHAR"}, {DT_INT16, 16, "MET_SHORT"}, {DT_FLOAT32, 32, "MET_FLOAT"},
-          {DT_FLOAT64, 64, "MET_DOUBLE"}};
+  return {{DT_UINT8, 8, "MET_UCHAR", "uchar"}, {DT_INT16, 16, "MET_SHORT", "short"},
+          {DT_FLOAT32, 32, "MET_FLOAT", "float"}, {DT_FLOAT64, 64, "MET_DOUBLE", "double"}};
 }
 
 inline const std::string& small_payload() {
@@ -92,9 +94,18 @@ inline std::string meta_header(const std::array<int64_t, 3>& d, const HostileTyp
          "\n";
 }
 
+inline std::string nrrd_header(const std::array<int64_t, 3>& d, const HostileType& t, const std::string& encoding,
+                               const std::string& data_file) {
+  return "NRRD0004\ntype: " + std::string(t.nrrd_name) + "\ndimension: 3\nspace: left-posterior-superior\nsizes: " +
+         std::to_string(d[0]) + " " + std::to_string(d[1]) + " " + std::to_string(d[2]) +
+         "\nspace directions: (1,0,0) (0,1,0) (0,0,1)\nspace origin: (0,0,0)\nendian: little\nencoding: " + encoding +
+         "\n" + (data_file.empty() ? "\n" : "data file: " + data_file + "\n");
+}
+
 /// The formats, by the suffix their file names end with.
 inline const std::vector<std::string>& hostile_formats() {
-  static const std::vector<std::string> f{"_n1.nii", "_n1.nii.gz", "_local.mha", "_z.mha", "_split.mhd"};
+  static const std::vector<std::string> f{"_n1.nii",   "_n1.nii.gz", "_local.mha", "_z.mha",
+                                          "_split.mhd", "_raw.nrrd", "_gz.nrrd",   "_split.nhdr"};
   return f;
 }
 
@@ -110,10 +121,13 @@ inline HostileFile hostile_file(const std::string& stem, const std::string& form
     return {name, meta_header(d, t, "CompressedData = True\nCompressedDataSize = " + std::to_string(z.size()) + "\n", "LOCAL") + z,
             "", ""};
   }
-  return {name, meta_header(d, t, "", stem + "_split.raw"), stem + "_split.raw", small_payload()};
+  if (format == "_split.mhd") return {name, meta_header(d, t, "", stem + "_split.raw"), stem + "_split.raw", small_payload()};
+  if (format == "_raw.nrrd") return {name, nrrd_header(d, t, "raw", "") + small_payload(), "", ""};
+  if (format == "_gz.nrrd") return {name, nrrd_header(d, t, "gzip", "") + gzip(small_payload()), "", ""};
+  return {name, nrrd_header(d, t, "raw", stem + "_nrrd.raw"), stem + "_nrrd.raw", small_payload()};
 }
 
-/// Every format × every size × every type: 5 formats, 23 sizes, 4 types.
+/// Every format × every size × every type: 8 formats, 23 sizes, 4 types.
 inline std::vector<HostileFile> hostile_files() {
   std::vector<HostileFile> out;
   const auto dims = hostile_dims();

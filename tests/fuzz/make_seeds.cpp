@@ -1,7 +1,7 @@
 // Writes the fuzzers' seed corpora: small valid volumes of every voxel type in every format pneumo
 // reads (so the fuzzers start from files that pass every header check and mutate from there), and
 // the scenes shipped in scenes/; and the hostile headers of tests/hostile_headers.h, so mutation
-// starts at the size checks too. Usage: make_seeds SOURCE_DIR OUT_DIR; OUT_DIR/{nifti,metaimage,scene}.
+// starts at the size checks too. Usage: make_seeds SOURCE_DIR OUT_DIR; OUT_DIR/{nifti,metaimage,nrrd,scene}.
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path source = argv[1], out = argv[2];
-  for (const char* sub : {"nifti", "metaimage", "scene"}) fs::create_directories(out / sub);
+  for (const char* sub : {"nifti", "metaimage", "nrrd", "scene"}) fs::create_directories(out / sub);
   std::mt19937 rng(20261124);
   const VoxelType types[] = {VoxelType::Int8,   VoxelType::UInt8,  VoxelType::Int16,   VoxelType::UInt16,
                              VoxelType::Int32,  VoxelType::UInt32, VoxelType::Float32, VoxelType::Float64};
@@ -41,11 +41,13 @@ int main(int argc, char** argv) {
     write_volume(v, (out / "nifti" / (stem + ".nii.gz")).string());
     write_volume(v, (out / "metaimage" / (stem + ".mha")).string());
     write_volume(v, (out / "metaimage" / (stem + "_z.mha")).string(), WriteOptions{true});
+    write_volume(v, (out / "nrrd" / (stem + ".nrrd")).string());
   }
   for (const hostile::HostileFile& f : hostile::hostile_files()) {
     if (!f.data_file_name.empty()) continue;   // the fuzzers read one file
-    const bool nifti = f.name.find(".nii") != std::string::npos;
-    std::ofstream(out / (nifti ? "nifti" : "metaimage") / ("hostile_" + f.name), std::ios::binary) << f.bytes;
+    const bool nifti = f.name.find(".nii") != std::string::npos, nrrd = f.name.find(".nrrd") != std::string::npos;
+    std::ofstream(out / (nifti ? "nifti" : nrrd ? "nrrd" : "metaimage") / ("hostile_" + f.name), std::ios::binary)
+        << f.bytes;
   }
   for (const auto& e : fs::directory_iterator(source / "scenes"))
     if (e.path().extension() == ".json")
