@@ -90,6 +90,7 @@ TEST(DicomSeries, WhatIsNotOneCtVolumeIsRefusedSayingWhy) {
       {"modality=MR", "modality \"MR\""},
       {"drop=4", "not evenly spaced"},
       {"tilt_mm=1", "tilted gantry"},
+      {"short_pixels=1", "bytes where Rows × Columns need"},
   };
   int index = 0;
   for (const auto& c : cases) {

@@ -197,6 +197,12 @@ Volume read_dicom_series(const std::string& dir) {
       throw file_error(dir, name_of(slices[s].file) + " is not a greyscale (MONOCHROME2) image");
     if (image.GetDimension(0) != unsigned(g.dims[0]) || image.GetDimension(1) != unsigned(g.dims[1]))
       throw file_error(dir, name_of(slices[s].file) + ": its pixel data is not Rows × Columns");
+    // Uncompressed pixel data shorter than Rows × Columns is refused before the slice's buffer is
+    // allocated from what Rows and Columns promise (compressed data is checked by decoding it).
+    const gdcm::ByteValue* stored = image.GetDataElement().GetByteValue();
+    if (stored && stored->GetLength() < image.GetBufferLength())
+      throw file_error(dir, name_of(slices[s].file) + ": its pixel data holds " + std::to_string(stored->GetLength()) +
+                                " bytes where Rows × Columns need " + std::to_string(image.GetBufferLength()));
     buffer.resize(image.GetBufferLength());
     if (!image.GetBuffer(buffer.data())) throw file_error(dir, name_of(slices[s].file) + ": cannot decode its pixels");
     const double slope = image.GetSlope(), intercept = image.GetIntercept();

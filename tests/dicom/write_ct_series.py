@@ -10,6 +10,7 @@ through Rescale Slope and Intercept. Used by tests/test_dicom_series.cpp, so tha
     split=0                   1: the upper half of the slices in a second series, to be refused
     drop=-1                   the index of a slice to leave out (a missing slice), to be refused
     tilt_mm=0                 shift each slice sideways by k * tilt_mm (a tilted gantry), to be refused
+    short_pixels=0            1: the last slice's pixel data cut to half of Rows x Columns, to be refused
 """
 import os
 import random
@@ -31,7 +32,8 @@ def ds(values):
 
 def main():
     nifti, out = sys.argv[1], sys.argv[2]
-    opt = dict(slope="1", intercept="-2048", shuffle="1", modality="CT", split="0", drop="-1", tilt_mm="0")
+    opt = dict(slope="1", intercept="-2048", shuffle="1", modality="CT", split="0", drop="-1", tilt_mm="0",
+               short_pixels="0")
     for arg in sys.argv[3:]:
         key, value = arg.split("=", 1)
         if key not in opt:
@@ -79,6 +81,8 @@ def main():
         if stored.min() < 0 or stored.max() > 65535:
             sys.exit("HU out of the unsigned 16-bit range of this rescale")
         d.PixelData = stored.astype("<u2").tobytes()
+        if opt["short_pixels"] == "1" and k == nz - 1:
+            d.PixelData = d.PixelData[: len(d.PixelData) // 2]
         d.save_as(os.path.join(out, name), write_like_original=False)
     print(nz - (1 if 0 <= int(opt["drop"]) < nz else 0), "slices")
 
