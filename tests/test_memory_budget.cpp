@@ -161,6 +161,12 @@ class MeshEstimate : public ::testing::TestWithParam<int> {};
 // above the truth would refuse meshes that fit. (Resident memory is a lower bound on what the
 // allocator reserved, so the bound below is loose on purpose.)
 TEST_P(MeshEstimate, CoversWhatTheBuildTakesWithoutRefusingWhatFits) {
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer pads every allocation with redzones and keeps freed memory in quarantine, so
+  // resident memory there measures the sanitizer as well as the mesh (119.0 MiB estimated, 121.8
+  // measured at L = 2): the comparison holds only in an uninstrumented build.
+  GTEST_SKIP() << "resident memory under AddressSanitizer is not the mesh's";
+#endif
   const int L = GetParam();
   const PhantomRoles& roles = small_phantom_roles();
   MeshOptions opt;
