@@ -190,7 +190,8 @@ Volume read_nrrd(const std::string& path) {
   require_volume_memory(path, g, type);
 
   NrrdPtr n(nrrdNew());
-  if (nrrdLoad(n.get(), path.c_str(), nullptr) != 0) throw file_error(path, "not a readable NRRD: " + teem_error());
+  IoPtr io(nrrdIoStateNew());   // ours, not one teem makes itself: its error paths then leak nothing
+  if (nrrdLoad(n.get(), path.c_str(), io.get()) != 0) throw file_error(path, "not a readable NRRD: " + teem_error());
   if (voxel_type_of_nrrd(path, n->type) != type || n->dim != 3 || !geometry_of(path, *n).same_grid(g, 0.0))
     throw file_error(path, "changed while it was read");
   Volume v(g, type);
