@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <stdexcept>
 
 namespace pneumo {
 
@@ -65,6 +66,20 @@ RgbImage vconcat(const std::vector<RgbImage>& images, int gap_px, Rgb background
     out.blit(im, 0, y);
     y += im.height + gap_px;
   }
+  return out;
+}
+
+RgbImage box_downscale(const RgbImage& image, int factor) {
+  if (factor < 1) throw std::invalid_argument("box_downscale: factor must be at least 1");
+  RgbImage out((image.width + factor - 1) / factor, (image.height + factor - 1) / factor);
+  for (int y = 0; y < out.height; ++y)
+    for (int x = 0; x < out.width; ++x) {
+      int sum[3] = {0, 0, 0}, n = 0;
+      for (int v = y * factor; v < std::min(image.height, (y + 1) * factor); ++v)
+        for (int u = x * factor; u < std::min(image.width, (x + 1) * factor); ++u, ++n)
+          for (int c = 0; c < 3; ++c) sum[c] += image.pixel(u, v)[c];
+      for (int c = 0; c < 3; ++c) out.pixel(x, y)[c] = uint8_t((sum[c] + n / 2) / n);
+    }
   return out;
 }
 

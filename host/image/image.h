@@ -29,5 +29,8 @@ struct RgbImage {
 RgbImage hconcat(const std::vector<RgbImage>& images, int gap_px, Rgb background);
 /// Images one under another, left-aligned.
 RgbImage vconcat(const std::vector<RgbImage>& images, int gap_px, Rgb background);
+/// `factor`× smaller by the mean of each factor×factor block (a box filter: no aliasing of the
+/// render's fine detail); a partial block at the right or bottom edge is averaged over what it holds.
+RgbImage box_downscale(const RgbImage& image, int factor);
 
 }  // namespace pneumo

@@ -107,6 +107,16 @@ void write_png_rgb(const std::string& path, int w, int h, const std::vector<uint
   write_bytes_atomic(path, bytes);
 }
 
+void write_jpeg(const std::string& path, const RgbImage& image, int quality) {
+  check_size(path, image.width, image.height, image.rgb.size(), 3);
+  if (quality < 1 || quality > 100) throw std::invalid_argument(path + ": JPEG quality must be 1 to 100");
+  check_writable_target(path);
+  std::string bytes;
+  if (!stbi_write_jpg_to_func(append_to_string, &bytes, image.width, image.height, 3, image.rgb.data(), quality))
+    throw std::runtime_error(path + ": stb_image_write failed to encode the JPEG");
+  write_bytes_atomic(path, bytes);
+}
+
 void write_png(const std::string& path, const RgbImage& image) {
   write_png_rgb(path, image.width, image.height, image.rgb);
 }
