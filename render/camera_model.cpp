@@ -31,6 +31,27 @@ std::optional<Vec3> ViewCamera::ray(double px, double py) const {
   return (std::cos(theta) * forward + std::sin(theta) / r * (x * right + y * up)).normalized();
 }
 
+std::optional<Eigen::Vector2d> ViewCamera::project(const Vec3& p_mm) const {
+  const Vec3 d = p_mm - position_mm;
+  const double f = d.dot(forward), a = d.dot(right), b = d.dot(up);
+  double x = 0.0, y = 0.0;   // normalised coordinates, as in ray()
+  if (lens == Lens::Pinhole) {
+    if (!(f > 0.0)) return std::nullopt;
+    const double t = std::tan(rad(fov_deg) * 0.5);
+    x = a / (f * t);
+    y = b / (f * t);
+  } else {
+    const double s = std::sqrt(a * a + b * b);
+    const double r = std::atan2(s, f) / (rad(fov_deg) * 0.5);   // θ = r·fov/2
+    if (r > 1.0) return std::nullopt;
+    if (s > 0.0) {
+      x = r * a / s;
+      y = r * b / s;
+    }
+  }
+  return Eigen::Vector2d(0.5 * (x + 1.0) * width, 0.5 * (1.0 - y * width / height) * height);
+}
+
 ScopePose look_at_pose(const Vec3& tip_mm, const Vec3& look_at_mm, const Vec3& up_hint) {
   const Vec3 d = look_at_mm - tip_mm;
   if (!(d.norm() > 1e-9)) throw InputError("the scope's aim " + show(look_at_mm) + " equals its tip; no direction");

@@ -41,6 +41,9 @@ struct ViewCamera {
 
   /// Ray direction (unit) through image point (px, py); nullopt outside a fisheye's image circle.
   std::optional<Vec3> ray(double px, double py) const;
+  /// The inverse: the image point (px, py) whose ray passes through `p_mm`; nullopt for a point
+  /// behind the camera (pinhole) or beyond the image circle (fisheye). It may lie off the image.
+  std::optional<Eigen::Vector2d> project(const Vec3& p_mm) const;
 };
 
 /// Applies optics (oblique angle, roll, lens, field of view, near distance) to a pose.

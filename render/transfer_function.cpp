@@ -111,6 +111,15 @@ TransferFunction preset_transfer_function(RenderPreset preset) {
       tf.opacity = {{-3024, 0.706}, {-900.046, 0.716}, {-500, 0}, {3071, 0}};
       tf.colour = {{-3024, 1, 1, 1}, {-900.046, 0.2, 1, 1}, {-500, 0.3, 1, 0.3}, {3071, 1, 1, 1}};
       break;
+    case RenderPreset::Skin:
+      // The body's outer surface, the iso-surface near -500 HU between air (-1000) and fat or skin
+      // (-100 and above) that surface renderings of the skin use: clear below -600 HU, opaque within
+      // the first 1 mm above -400 HU, so a ray from outside stops at the skin and gas inside the body
+      // never shows. One colour, 3D Slicer's "skin" entry of its GenericAnatomyColors table
+      // (177, 122, 101), so that the shape reads from the shading alone.
+      tf.opacity = {{-3024, 0}, {-600, 0}, {-400, 1}, {3071, 1}};
+      tf.colour = {{-3024, 0.694, 0.478, 0.396}, {3071, 0.694, 0.478, 0.396}};
+      break;
     case RenderPreset::Custom:
       throw InputError("the \"custom\" preset takes its points from render.custom_opacity and custom_colour");
   }

@@ -65,6 +65,37 @@ TEST(RenderCamera, ObliqueScopeLooksTiltedTowardsUpAndRollTurnsIt) {
   }
 }
 
+// project() inverts ray(): a point along a pixel's ray projects back onto that pixel (both lenses,
+// oblique and rolled), to 1e-9 px; points behind a pinhole or outside the fisheye circle project nowhere.
+TEST(RenderCamera, ProjectionIsTheInverseOfTheRay) {
+  for (const Lens lens : {Lens::Pinhole, Lens::Fisheye}) {
+    Optics o;
+    o.lens = lens;
+    o.fov_deg = lens == Lens::Pinhole ? 70 : 170;
+    o.oblique_deg = 30;
+    o.roll_deg = 25;
+    const ViewCamera c = camera(Vec3(5, -3, 2), Vec3(10, -40, 7), o, 120, 80);
+    int checked = 0;
+    for (double px : {3.5, 30.25, 60.0, 91.0, 117.5})
+      for (double py : {2.5, 40.0, 71.75}) {
+        const std::optional<Vec3> d = c.ray(px, py);
+        if (!d) continue;
+        const std::optional<Eigen::Vector2d> p = c.project(c.position_mm + 37.0 * *d);
+        ASSERT_TRUE(p.has_value()) << px << "," << py;
+        EXPECT_NEAR(p->x(), px, 1e-9);
+        EXPECT_NEAR(p->y(), py, 1e-9);
+        ++checked;
+      }
+    EXPECT_GE(checked, lens == Lens::Pinhole ? 15 : 9);
+  }
+  const ViewCamera pin = camera(Vec3(0, 0, 0), Vec3(0, -1, 0));
+  EXPECT_FALSE(pin.project(Vec3(0, 5, 0)).has_value());   // behind the camera
+  Optics fish;
+  fish.lens = Lens::Fisheye;
+  fish.fov_deg = 120;
+  EXPECT_FALSE(camera(Vec3(0, 0, 0), Vec3(0, -1, 0), fish).project(Vec3(0, 1, 0.1)).has_value());
+}
+
 TEST(RenderCamera, UpAlongTheAxisIsBadInput) {
   Optics o;
   o.up = Vec3(0, -1, 0);

@@ -27,7 +27,7 @@ inline bool solves_force_fields(SolverMethod m) {
   return m == SolverMethod::Static || m == SolverMethod::Newton || m == SolverMethod::ImplicitEuler;
 }
 enum class Lens : uint8_t { Pinhole, Fisheye };
-enum class RenderPreset : uint8_t { Laparoscopic, CtSoftTissue, CtMuscle, CtAaa, CtAir, Custom };
+enum class RenderPreset : uint8_t { Laparoscopic, CtSoftTissue, CtMuscle, CtAaa, CtAir, Skin, Custom };
 /// Speed against accuracy (scene_presets.h): what `pneumo bench` measured each to buy.
 enum class ScenePreset : uint8_t { None, Preview, Balanced, Accurate };
 /// The grid of the deformed CT and labels: the working grid (the CT with the roles' padding, which
@@ -66,8 +66,8 @@ template <> struct EnumNames<Lens> {
   static constexpr std::array<const char*, 2> names{"pinhole", "fisheye"};
 };
 template <> struct EnumNames<RenderPreset> {
-  static constexpr std::array<const char*, 6> names{"laparoscopic", "ct-soft-tissue", "ct-muscle",
-                                                    "ct-aaa", "ct-air", "custom"};
+  static constexpr std::array<const char*, 7> names{"laparoscopic", "ct-soft-tissue", "ct-muscle",
+                                                    "ct-aaa", "ct-air", "skin", "custom"};
 };
 
 template <> struct EnumNames<OutputGrid> {
