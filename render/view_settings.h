@@ -63,7 +63,7 @@ struct ViewSettings {
   double ambient = 0.15, diffuse = 0.85, specular = 0.25, shininess = 12.0;
   // preset "custom": Slicer-style flat lists [HU, α, HU, α, ...] and [HU, r, g, b, ...].
   std::vector<double> custom_opacity, custom_colour;
-  bool exterior_views = true;     // anterior and left views from outside with CT-Air (§8)
+  bool exterior_views = true;     // the skin from the front and the left, before | after, ports marked
   std::vector<Camera> cameras;
   std::vector<Port> ports;
   std::vector<CameraPath> paths;

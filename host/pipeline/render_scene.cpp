@@ -1,17 +1,21 @@
 #include "pipeline/render_scene.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
+#include "image/png.h"
 #include "io/volume_io.h"
+#include "pipeline/exterior_views.h"
 #include "pipeline/scene_stages.h"
 #include "render/camera_path.h"
 #include "render/image_out.h"
@@ -109,7 +113,14 @@ RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
     check_labels_on_ct_grid(ct.geometry(), labels->geometry(), run.ct_path, run.labels_path);
     check_label_values(*labels, run.labels_path);
   }
-  return render_volumes(scene, opt, ct, labels.get(), run);
+  // The exterior views show the body before inflation beside the deformed one.
+  RenderOptions with_before = opt;
+  std::optional<Volume> undeformed;
+  if (run.deformed && r.exterior_views && !opt.undeformed_ct) {
+    undeformed = read_volume(scene.require_ct());
+    with_before.undeformed_ct = &*undeformed;
+  }
+  return render_volumes(scene, with_before, ct, labels.get(), run);
 }
 
 RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Volume& ct, const Volume* labels,
@@ -216,39 +227,47 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Vol
   if (!paths.empty() && !mp4) log::info("render: ffmpeg not found; fly-throughs are PNG frames only");
 
   if (exterior) {
-    // The abdomen from outside with CT-Air: air connected to the grid's faces is hidden, so what
-    // shows is the gas inside the body (the insufflated cavity, bowel gas, lungs) as a surface.
-    // Last of all views: the volume is marked in place, not copied.
-    volume.mark_exterior_air();
-    renderer.set_volume(volume);
-    RenderSettings es = s;
-    es.tf = preset_transfer_function(RenderPreset::CtAir);
-    es.hide_exterior_air = true;
-    es.show_labels = false;
-    const Geometry& g = volume.geometry;
-    const Vec3 c = g.to_world(0.5 * Vec3(double(g.dims[0] - 1), double(g.dims[1] - 1), double(g.dims[2] - 1)));
-    const double radius = 0.5 * (g.to_world(Vec3::Zero()) -
-                                 g.to_world(Vec3(double(g.dims[0] - 1), double(g.dims[1] - 1), double(g.dims[2] - 1))))
-                                    .norm();
-    Optics o;
-    o.fov_deg = 40.0;
-    const double dist = radius / std::sin(o.fov_deg * 3.14159265358979323846 / 360.0);
-    o.near_mm = dist - radius;
-    es.light_falloff_mm = dist;  // the headlight as bright at the body as inside the cavity
-    const std::pair<const char*, Vec3> sides[] = {{"exterior_anterior", Vec3(0, 1, 0)}, {"exterior_left", Vec3(-1, 0, 0)}};
-    for (const auto& [name, side] : sides) {
-      const ViewCamera cam =
-          make_view_camera(look_at_pose(c + dist * side, c, Vec3(0, 0, 1)), o, r.width, r.height);
-      const std::string rel = std::string("views/") + name + ".png";
-      write_view_png((out / rel).string(), renderer.render(cam, es));
+    // The body from outside: the skin, after inflation and (when the CT before it is at hand) before
+    // it, side by side under one camera, the ports marked. Last of all views, since the CT before
+    // inflation replaces the volume on the renderer.
+    const std::vector<ExteriorCamera> cameras = exterior_cameras(volume.geometry, r.width, r.height);
+    std::vector<SkinMark> before_marks, after_marks;
+    for (const Port& p : r.ports) {
+      before_marks.push_back({p.name, p.skin_point_mm});
+      after_marks.push_back({p.name, map(p.skin_point_mm)});
+    }
+    std::vector<RenderImage> after;
+    for (const ExteriorCamera& c : cameras) after.push_back(renderer.render(c.camera, skin_settings(s, c.camera, volume.geometry)));
+    std::vector<RenderImage> before;
+    if (opt.undeformed_ct) {
+      const RenderVolume undeformed = RenderVolume::from(*opt.undeformed_ct, nullptr);
+      renderer.set_volume(undeformed);
+      for (const ExteriorCamera& c : cameras)
+        before.push_back(renderer.render(c.camera, skin_settings(s, c.camera, volume.geometry)));
+    }
+    for (std::size_t k = 0; k < cameras.size(); ++k) {
+      const ExteriorCamera& c = cameras[k];
+      const AnnotatedView a = annotated_view(after[k], c.camera, run.deformed ? opt.deformed_caption : "CT as given",
+                                             run.deformed ? after_marks : before_marks);
+      RgbImage picture = a.image;
+      nlohmann::json marked = a.marked;
+      if (!before.empty()) {
+        const AnnotatedView b = annotated_view(before[k], c.camera, "before inflation", before_marks);
+        picture = hconcat({b.image, a.image}, 4, Rgb{255, 255, 255});
+        marked = {{"before", b.marked}, {"after", a.marked}};
+      }
+      const std::string rel = "views/" + c.name + ".png";
+      write_png_rgb((out / rel).string(), picture.width, picture.height, picture.rgb);
       run.files.push_back(rel);
-      nlohmann::json j = pose_json(cam);
-      j["name"] = name;
+      nlohmann::json j = pose_json(c.camera);
+      j["name"] = c.name;
       j["file"] = rel;
-      j["preset"] = "ct-air";
+      j["preset"] = "skin";
+      j["panels"] = before.empty() ? nlohmann::json::array({"after"}) : nlohmann::json::array({"before", "after"});
+      j["ports_marked"] = marked;
       view_report.push_back(j);
       ++run.views;
-      tick(name);
+      tick(c.name);
     }
   }
   progress.finish(std::to_string(run.views) + " views, " + std::to_string(run.frames) + " frames");

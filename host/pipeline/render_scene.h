@@ -8,7 +8,8 @@
 // Outputs under out_dir (each file atomic):
 //   views/<name>.png                 cameras and ports (and <name>_depth.png with output.write_depth:
 //                                    16-bit, 0.1 mm per unit, 0 = no surface)
-//   views/exterior_anterior.png, views/exterior_left.png   (render.exterior_views)
+//   views/exterior_anterior.png, views/exterior_left.png   (render.exterior_views): the skin
+//                                    before | after inflation, ports marked (exterior_views.h)
 //   flythrough/<path>/frame_0001.png ...  and flythrough/<path>.mp4 when ffmpeg is on PATH
 //   render.json                      volume used, GL back end/version/renderer, poses, files
 #include <filesystem>
@@ -30,6 +31,10 @@ struct RenderOptions {
   GlBackend backend = GlBackend::Auto;
   bool cpu_reference = false;   // render with the CPU reference instead of OpenGL (slow; checks)
   PointMapFn map_point;           // original CT mm → deformed mm; empty = identity
+  // The CT before inflation, when the volume rendered is the deformed one: the exterior views show
+  // it beside (null: the deformed body alone, as the inflation preview's frames do).
+  const Volume* undeformed_ct = nullptr;
+  std::string deformed_caption = "after inflation";   // the exterior views' caption on the deformed body
 };
 
 struct RenderRun {

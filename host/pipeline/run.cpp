@@ -1,6 +1,7 @@
 #include "pipeline/run.h"
 
 #include <chrono>
+#include <cstdio>
 #include <climits>
 #include <memory>
 #include <optional>
@@ -157,6 +158,10 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   ro.out_dir = o.out_dir;
   ro.backend = o.backend;
   ro.map_point = map;
+  ro.undeformed_ct = &w.ct;
+  char caption[64];
+  std::snprintf(caption, sizeof caption, "after inflation, %.1f mmHg", w.deformation.pressure_pa / units::kPaPerMmHg);
+  ro.deformed_caption = caption;
   // The warped volumes from memory, not read back from the files just written.
   RenderRun what;
   what.deformed = true;

@@ -60,6 +60,10 @@ void Timelapse::frame(const SolverSnapshot& snapshot) {
   ro.out_dir = scratch.string();
   ro.backend = backend_;
   ro.map_point = deformed_point_fn(point_map, false);   // the final render says it once
+  char caption[64];
+  std::snprintf(caption, sizeof caption, "step %lld, %.1f mmHg", static_cast<long long>(snapshot.step),
+                snapshot.pressure_pa / units::kPaPerMmHg);
+  ro.deformed_caption = caption;
   RenderRun run;
   run.deformed = true;
   run.ct_path = "(warped at step " + std::to_string(snapshot.step) + ")";

@@ -374,7 +374,8 @@ const Table<ViewSettings>& render_table() {
       {"specular", &ViewSettings::specular, "", in(0, 1), "Phong specular coefficient (white highlights)."},
       {"shininess", &ViewSettings::shininess, "", in(1, 1000), "Phong specular exponent."},
       {"exterior_views", &ViewSettings::exterior_views, "", any(),
-       "Also render the abdomen from outside (anterior and left) with CT-Air: the gas cavity as a surface (§8)."},
+       "Also render the body from outside (anterior and left): the skin as a surface near -500 HU, before and after "
+       "inflation side by side, the ports marked (§8)."},
       {"step_fraction", &ViewSettings::step_fraction, "", above(0, 0.5),
        "Ray step as a fraction of the smallest voxel spacing (§8: at most half)."},
       {"jitter", &ViewSettings::jitter, "", any(), "Offset each ray's start randomly (hides wood-grain bands; images then vary)."},

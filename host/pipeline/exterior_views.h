@@ -1,0 +1,48 @@
+#pragma once
+// Exterior views: the body's skin as a surface (the "skin" transfer function, the iso-surface near
+// -500 HU), from in front and from the left, before and after inflation side by side, each port
+// marked where its skin point lies. The same cameras frame both panels, so the rise of the dome is
+// read by comparing them.
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+#include "render/camera_model.h"
+#include "render/render_settings.h"
+
+namespace pneumo {
+
+struct ExteriorCamera {
+  std::string name;   // "exterior_anterior", "exterior_left"
+  ViewCamera camera;
+};
+
+/// The anterior and left cameras around grid `g`: a 40° pinhole at the distance where the grid's
+/// bounding sphere fills the width, image up along +z (superior).
+std::vector<ExteriorCamera> exterior_cameras(const Geometry& g, int width, int height);
+
+/// `s` with the skin transfer function and no label colours; the headlight's falloff distance set
+/// to the camera's distance from the grid's centre, so the body is lit as the cavity is from inside.
+RenderSettings skin_settings(const RenderSettings& s, const ViewCamera& camera, const Geometry& g);
+
+struct SkinMark {
+  std::string name;
+  Vec3 point_mm = Vec3::Zero();
+};
+
+/// How far behind the surface a ray found a mark may lie and still be drawn (mm): a skin point
+/// given a few mm inside the skin is marked; one on the far side of the body (tens of cm) is not.
+inline constexpr double kMarkDepthToleranceMm = 20.0;
+
+struct AnnotatedView {
+  RgbImage image;
+  std::vector<std::string> marked;   // the marks drawn (visible from this camera)
+};
+
+/// A rendered view as an 8-bit image: `caption` at the top-left, each visible mark as a ring with
+/// its name. A mark is visible when it projects into the image and lies no deeper than
+/// kMarkDepthToleranceMm behind the first surface along its pixel's ray.
+AnnotatedView annotated_view(const RenderImage& image, const ViewCamera& camera, const std::string& caption,
+                             const std::vector<SkinMark>& marks);
+
+}  // namespace pneumo
