@@ -17,6 +17,7 @@
 #include "io/volume_io.h"
 #include "mesh/deformation_file.h"
 #include "pipeline/render_scene.h"
+#include "pipeline/report_views.h"
 #include "pipeline/simulate.h"
 #include "pipeline/timelapse.h"
 #include "pipeline/warp_stage.h"
@@ -184,15 +185,16 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   metrics["render"] = {{"views", rendered.views}, {"frames", rendered.frames}, {"deformed_ct", rendered.deformed}};
   ReportContent rc;
   rc.title = "pneumo: " + (scene.name.empty() ? scene.path : scene.name);
+  rc.description = scene.description;
   rc.scene = scene.echo();
   rc.plots.push_back({"Convergence", convergence_plot_svg(sim.result)});
   if (!sim.pressure_curve.empty()) rc.plots.push_back({"Pressure-volume curve", pressure_curve_plot_svg(sim.pressure_curve)});
-  rc.images.push_back({"Roles: wall orange, viscera green, fixed blue", (out / "roles.png").string()});
   if (fs::exists(out / "slices_before_after.png"))
-    rc.images.push_back({"Before and after (axial, coronal, sagittal)", (out / "slices_before_after.png").string()});
-  for (const std::string& f : rendered.files)
-    if (f.rfind("views/", 0) == 0 && f.find("_depth") == std::string::npos)
-      rc.images.push_back({f.substr(6, f.size() - 10), (out / f).string()});
+    rc.images.push_back({"Slices before and after", (out / "slices_before_after.png").string(),
+                         "Axial, coronal and sagittal through the cavity's centre: the CT as given (top) and warped (bottom), the gas in blue."});
+  rc.images.push_back({"Roles", (out / "roles.png").string(),
+                       "What moves and what holds: wall orange, viscera green, fixed blue."});
+  add_rendered_views(rc, rendered.report, scene.render, w.label_names, out);
   metrics["stage_seconds"]["render"] = seconds_render;
   metrics["stage_seconds"]["report"] = seconds_since(t_report);
   metrics["stage_seconds"]["total"] = seconds_since(t_run);

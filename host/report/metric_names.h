@@ -1,0 +1,26 @@
+#pragma once
+// What the report calls each key of metrics.json: a name a reader understands, its unit, and the
+// group it is shown in. Keys without an entry are named from the key itself, the unit from its
+// suffix (_mm, _ml, _mmhg, _s, _ms, _fraction ...), so a new metric never shows as a raw key.
+#include <string>
+#include <vector>
+
+namespace pneumo {
+
+struct MetricName {
+  std::string name;    // "Anterior rise"
+  std::string unit;    // "mm"; empty when dimensionless
+  std::string group;   // "Result", "Solver", "Model", "Warp", "Other"
+  double scale = 1.0;  // shown value = stored value × scale (a fraction as %)
+};
+
+/// The name of `key` (a top-level key, or "parent.child" for a nested one).
+MetricName metric_name(const std::string& key);
+
+/// The report's groups, in the order shown.
+const std::vector<std::string>& metric_groups();
+
+/// The pipeline's stages in the order they run (stage_seconds' keys), "total" last.
+const std::vector<std::string>& pipeline_stage_order();
+
+}  // namespace pneumo
