@@ -24,6 +24,8 @@ packages=(
   # ITK applies the displacement field pneumo writes and nibabel reads it (tests/test_displacement_field.cpp),
   # pydicom writes the DICOM series pneumo reads (tests/test_dicom_series.cpp)
   libgtest-dev googletest libbenchmark-dev python3-vtk9 python3-numpy python3-nibabel python3-pydicom libinsighttoolkit5-dev
+  # headless Chromium loads report.html and takes a screenshot of it (tests/test_report_browser.cpp)
+  chromium
 )
 if [ "${1:-}" = "--peers" ]; then
   packages+=(python3-scipy libglew-dev)
