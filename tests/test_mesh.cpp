@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/units.h"
 #include "load_test_support.h"
+#include "mesh/cube_lattice.h"
 #include "mesh/mesh.h"
 
 namespace pneumo {
@@ -480,11 +481,14 @@ TEST(MeshErrors, NothingToMeshThrowsInputError) {
   EXPECT_THROW(build(fixed_only, 1, MeshModel::WallViscera), InputError);
 }
 
-TEST(MeshTissue, ModulusIsTheVolumeAverageOfTheVoxels) {
-  // Compared: one cube of 4×4×4 wall voxels (L = 4) whose lower half is fat (HU −100 → 2 kPa) and upper half
-  // muscle (HU +50 → 60 kPa), against the volume average: Σ_t E_t V_t = ½ (2 + 60) kPa × V, within the
-  // sampling of the tetrahedra (voxel centres: the central one is oversampled, 1 %); all fat gives 2 kPa in
-  // every tetrahedron exactly, and the modulus by label alone (no CT) 60 kPa.
+TEST(MeshTissue, ModulusIsHillsMeanOfTheVoxelsInEachTetrahedron) {
+  // Compared: one cube of 4×4×4 wall voxels (L = 4, one sample per voxel at its centre) whose lower half is
+  // fat (HU −100 → 2 kPa) and upper half muscle (HU +50 → 60 kPa). Each tetrahedron's modulus against Hill's
+  // mean of the voxels whose centres it holds, derived here from the points alone: ½ (arithmetic + harmonic
+  // mean), to rounding; every mixed tetrahedron strictly between the Reuss and Voigt bounds; the volume
+  // average below the Voigt average ½ (2 + 60) kPa = 31 kPa, which the Voigt mean alone gave (a mixed linear
+  // tetrahedron cannot strain more in the fat than in the muscle). All fat gives 2 kPa in every tetrahedron
+  // exactly, and the modulus by label alone (no CT) 60 kPa.
   Voxels v(4, 4, 4, 1.0, Role::Wall);
   std::vector<float> hu(v.roles.size());
   for (int64_t k = 0; k < 4; ++k)
@@ -495,12 +499,33 @@ TEST(MeshTissue, ModulusIsTheVolumeAverageOfTheVoxels) {
   o.cube_voxels = 4;
   o.model = MeshModel::Wall;
   const Mesh half = build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}, o, young);
+  ASSERT_EQ(half.tets.size(), 5u);
+  double sum[5] = {0, 0, 0, 0, 0}, compliance[5] = {0, 0, 0, 0, 0};
+  int n[5] = {0, 0, 0, 0, 0};
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const int t = lattice::tet_holding({(i + 0.5) / 4, (j + 0.5) / 4, (k + 0.5) / 4}, false);
+        const double e = k < 2 ? 2e3 : 60e3;
+        sum[t] += e;
+        compliance[t] += 1.0 / e;
+        ++n[t];
+      }
   double ev = 0.0, vol = 0.0;
-  for (std::size_t t = 0; t < half.tets.size(); ++t) {
+  int mixed = 0;
+  for (int t = 0; t < 5; ++t) {
+    const double voigt = sum[t] / n[t], reuss = n[t] / compliance[t];
+    EXPECT_NEAR(half.tet_young_pa[t], 0.5 * (voigt + reuss), 1e-9 * voigt) << "tetrahedron " << t;
+    if (voigt - reuss > 1.0) {
+      ++mixed;
+      EXPECT_GT(half.tet_young_pa[t], reuss);
+      EXPECT_LT(half.tet_young_pa[t], voigt);
+    }
     ev += half.tet_young_pa[t] * half.tet_rest_volume_m3[t];
     vol += half.tet_rest_volume_m3[t];
   }
-  EXPECT_NEAR(ev / vol, 31e3, 0.01 * 31e3);
+  EXPECT_GE(mixed, 4);   // the corner tetrahedra reach across the mid-plane, and so does the central one
+  EXPECT_LT(ev / vol, 0.9 * 31e3);
   std::fill(hu.begin(), hu.end(), -100.0f);
   const Mesh fat = build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}, o, young);
   for (double e : fat.tet_young_pa) EXPECT_DOUBLE_EQ(e, 2e3);

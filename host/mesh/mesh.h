@@ -125,7 +125,7 @@ struct Mesh {
   std::vector<double> tet_fraction;         // share of its volume its part's tissue fills (≥ kMinTissueFraction)
   std::vector<int64_t> tet_cube;            // linear cube index
   std::vector<double> tet_rest_volume_m3;
-  std::vector<double> tet_young_pa;         // the volume average over its tissue (0 outside it), floored
+  std::vector<double> tet_young_pa;         // Hill's mean over its tissue × the tissue's share, floored
   std::vector<double> tet_poisson;          // ν of the finite elements (empty: 1/4, the springs' own)
   std::vector<std::array<int32_t, 6>> tet_springs;   // spring of each local edge (kTetEdges order)
 
