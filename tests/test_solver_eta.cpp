@@ -67,5 +67,42 @@ TEST(SolverEta, ASlowFallIsCappedAtTheStepBudgetAndFewSamplesGiveNone) {
       << "at the tolerance already: no estimate";
 }
 
+TEST(SolverEta, ALoadIncrementIsNotReadAsDivergence) {
+  // A static scheme's load in three increments (4, 8, 12 mmHg as Pa 533, 1067, 1600), each solved
+  // to 1e-3 and then raised, the residual jumping back to 0.5. Before the last increment: the time so
+  // far (step × s/step) scaled by the load still to apply, (1600 − 1067) / 1067 of it, not the step
+  // budget. Two samples into the last increment: no estimate yet (the jump is not a rising residual).
+  // Five samples into it: the decay of this increment alone, closed form as above.
+  std::vector<SolveSample> h;
+  int64_t step = 0;
+  for (double p : {533.0, 1067.0}) {
+    for (int i = 0; i < 8; ++i) {
+      SolveSample s;
+      s.step = ++step;
+      s.pressure_pa = p;
+      s.residual = 0.5 * std::pow(0.3, i);
+      h.push_back(s);
+    }
+  }
+  const SolverEta mid = solver_eta(h, 1e-3, 1000000, 2.0, 0.0, 1600.0);
+  EXPECT_FALSE(mid.step_limit);
+  EXPECT_NEAR(mid.seconds, 16 * 2.0 * (1600.0 - 1067.0) / 1067.0, 1e-9);
+  for (int i = 0; i < 5; ++i) {
+    SolveSample s;
+    s.step = ++step;
+    s.pressure_pa = 1600.0;
+    s.residual = 0.5 * std::pow(0.3, i);
+    h.push_back(s);
+    const SolverEta eta = solver_eta(h, 1e-3, 1000000, 2.0, 0.0, 1600.0);
+    EXPECT_FALSE(eta.step_limit) << "sample " << i;
+    if (i < 4) {
+      EXPECT_LT(eta.seconds, 0.0) << "sample " << i;
+    } else {
+      const double expected = (std::log(1e-3) - std::log(0.5 * std::pow(0.3, 4))) / std::log(0.3) * 2.0;
+      EXPECT_NEAR(eta.seconds, expected, 1e-9 * expected);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace pneumo::detail

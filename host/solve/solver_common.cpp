@@ -172,23 +172,36 @@ void Monitor::check_diverged(double max_displacement_m, int64_t step, const std:
 }
 
 SolverEta solver_eta(const std::vector<SolveSample>& history, double tolerance, int64_t max_steps,
-                     double seconds_per_step) {
+                     double seconds_per_step, double start_pressure_pa, double final_pressure_pa) {
   SolverEta out;
   if (history.empty()) return out;
   const SolveSample& now = history.back();
   const double budget_s = double(std::max<int64_t>(max_steps - now.step, 0)) * seconds_per_step;
+  // Still raising the load (a static scheme's increments, a dynamic scheme's ramp): the residual of
+  // this load says nothing of the loads to come, and right after an increment it jumps by orders of
+  // magnitude, which read as "never converges" once showed "ETA ~35h" to a 30 s solve. The load still
+  // to apply is estimated to take as long per unit of load as the load applied so far has.
+  const double span = final_pressure_pa - start_pressure_pa;
+  const double applied = span != 0.0 ? (now.pressure_pa - start_pressure_pa) / span : 1.0;
+  if (applied < 1.0 - 1e-9) {
+    if (applied > 0.0) out.seconds = std::min(double(now.step) * seconds_per_step * (1.0 - applied) / applied, budget_s);
+    return out;
+  }
   if (!(now.residual > tolerance)) return out;   // there: no estimate needed
-  // The slower of the decay rates over the last 5 and the last 20 monitoring samples: an oscillating
-  // residual dips for a few samples at a time, and a dip alone once promised "~0.1 s" to a run that
-  // never converged.
+  // The slower of the decay rates over the last 5 and the last 20 monitoring samples at this load: an
+  // oscillating residual dips for a few samples at a time, and a dip alone once promised "~0.1 s" to
+  // a run that never converged.
+  std::size_t at_this_load = 0;
+  while (at_this_load < history.size() && history[history.size() - 1 - at_this_load].pressure_pa == now.pressure_pa)
+    ++at_this_load;
+  if (at_this_load < 5) return out;
   double rate = -INFINITY;
   for (std::size_t back : {std::size_t(4), std::size_t(19)}) {
-    if (history.size() <= back) continue;
+    if (back >= at_this_load) continue;
     const SolveSample& old = history[history.size() - 1 - back];
     if (now.step <= old.step || !(old.residual > 0.0)) continue;
     rate = std::max(rate, (std::log(now.residual) - std::log(old.residual)) / double(now.step - old.step));
   }
-  if (history.size() < 5) return out;
   if (rate < 0.0 && std::isfinite(rate)) out.seconds = (std::log(tolerance) - std::log(now.residual)) / rate * seconds_per_step;
   // Never past the step budget: the run ends there whatever the residual does.
   if (out.seconds < 0.0 || out.seconds > budget_s) {
@@ -232,7 +245,8 @@ bool Monitor::record(int64_t step, double time_s, double pressure_pa, double res
                 units::m_to_mm(s.max_displacement_m));
   const double seconds_per_step =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count() / double(std::max<int64_t>(step, 1));
-  const SolverEta eta = solver_eta(r_.history, opt_.residual_tolerance, opt_.max_steps, seconds_per_step);
+  const SolverEta eta = solver_eta(r_.history, opt_.residual_tolerance, opt_.max_steps, seconds_per_step,
+                                   opt_.start_pressure_pa, opt_.forces.pressure_pa);
   std::string shown = detail;
   // During a dynamic scheme's ramp the residual grows with the load: no cause for a warning yet. The
   // static schemes (time 0, no time step) step their load in increments instead.

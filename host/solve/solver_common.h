@@ -16,15 +16,17 @@ namespace pneumo::detail {
 
 class Monitor;
 
-/// The progress line's ETA (seconds; < 0: none yet) from the residual history: log-linear decay to
-/// `tolerance` at the slower of the recent rates, never beyond the time left to `max_steps`;
-/// `step_limit` when that budget is what bounds it (the residual is not falling fast enough).
+/// The progress line's ETA (seconds; < 0: none yet) from the residual history: at the full load,
+/// log-linear decay to `tolerance` at the slower of the recent rates at that load, never beyond the
+/// time left to `max_steps`, `step_limit` when that budget is what bounds it (the residual is not
+/// falling fast enough); while the load still rises from `start_pressure_pa` to
+/// `final_pressure_pa`, the time so far scaled by the load still to apply.
 struct SolverEta {
   double seconds = -1.0;
   bool step_limit = false;
 };
 SolverEta solver_eta(const std::vector<SolveSample>& history, double tolerance, int64_t max_steps,
-                     double seconds_per_step);
+                     double seconds_per_step, double start_pressure_pa = 0.0, double final_pressure_pa = 0.0);
 
 // ---- shared by the CPU reference and the device solvers ----------------------------------------
 
