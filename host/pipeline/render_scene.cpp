@@ -218,9 +218,9 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Vol
       char name[32];
       std::snprintf(name, sizeof name, "frame_%04zu.png", f + 1);
       const RenderImage frame = renderer.render(p.cameras[f], s);
-      write_view_png((dir / name).string(), frame);
       RgbImage rgb(frame.width, frame.height);
-      rgb.rgb = to_rgb8(frame);
+      rgb.rgb = to_rgb8(frame);   // once, for the PNG and the strip's thumbnail
+      write_png((dir / name).string(), rgb);
       thumbnails.push_back(box_downscale(rgb, strip_downscale(frame.width)));
       run.files.push_back("flythrough/" + p.name + "/" + name);
       ++run.frames;
