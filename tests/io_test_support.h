@@ -64,4 +64,11 @@ inline std::string read_bytes(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>());
 }
 
+/// How many times `what` occurs in `s` (overlapping occurrences counted).
+inline int count_occurrences(const std::string& s, const std::string& what) {
+  int n = 0;
+  for (std::size_t at = s.find(what); at != std::string::npos; at = s.find(what, at + 1)) ++n;
+  return n;
+}
+
 }  // namespace pneumo::testing_support

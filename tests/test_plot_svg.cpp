@@ -4,6 +4,7 @@
 #include <cmath>
 #include <regex>
 
+#include "io_test_support.h"
 #include "report/plot_svg.h"
 
 using namespace pneumo;
@@ -21,12 +22,6 @@ std::vector<std::pair<double, double>> polyline_points(const std::string& svg) {
     while (in >> x >> comma >> y) out.push_back({x, y});
   }
   return out;
-}
-
-int count(const std::string& s, const std::string& what) {
-  int n = 0;
-  for (std::size_t at = s.find(what); at != std::string::npos; at = s.find(what, at + 1)) ++n;
-  return n;
 }
 
 }  // namespace
@@ -75,7 +70,7 @@ TEST(PlotSvg, LogAxisSpacesDecadesEquallyAndSkipsWhatItCannotDraw) {
   const auto p = polyline_points(svg);
   ASSERT_EQ(p.size(), 3u);   // the single points 1e-4 and 1e-5 make no line
   EXPECT_NEAR(p[1].second - p[0].second, p[2].second - p[1].second, 0.15);
-  EXPECT_EQ(count(svg, "<polyline"), 1);
+  EXPECT_EQ(testing_support::count_occurrences(svg, "<polyline"), 1);
   EXPECT_EQ(svg.find("nan"), std::string::npos);
   EXPECT_EQ(svg.find("inf"), std::string::npos);
 }
@@ -93,6 +88,6 @@ TEST(PlotSvg, TextIsEscapedAndStackedPanelsAddUp) {
   EXPECT_NE(one.find("a&lt;b"), std::string::npos);   // in the legend
   const std::string both = stack_svg({one, line_plot_svg({s}, b)});
   EXPECT_NE(both.find("height=\"700\""), std::string::npos);
-  EXPECT_EQ(count(both, "<svg "), 3);
+  EXPECT_EQ(testing_support::count_occurrences(both, "<svg "), 3);
   EXPECT_NE(both.find("y=\"400\""), std::string::npos);
 }

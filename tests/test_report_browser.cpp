@@ -45,12 +45,6 @@ Pixels load_png(const std::string& path) {
   return p;
 }
 
-int count(const std::string& s, const std::string& what) {
-  int n = 0;
-  for (std::size_t at = s.find(what); at != std::string::npos; at = s.find(what, at + 1)) ++n;
-  return n;
-}
-
 }  // namespace
 
 TEST(ReportBrowser, ChromiumShowsTheViewsTheSkinAndTheFlyThrough) {
@@ -87,12 +81,12 @@ TEST(ReportBrowser, ChromiumShowsTheViewsTheSkinAndTheFlyThrough) {
 
   const testing_support::CliResult dom = testing_support::run_shell(chromium(dir, "--dump-dom file://" + report.string()));
   ASSERT_EQ(dom.code, 0) << dom.err;
-  EXPECT_EQ(count(dom.out, "<figcaption>"), 8) << "4 views, the fly-through, the slices, the roles, the plot";
-  EXPECT_EQ(count(dom.out, "<img "), 6) << "the port, the camera, 2 exterior views, the slices, the roles";
-  EXPECT_EQ(count(dom.out, "class=\"strip0 player\""), 1);
+  EXPECT_EQ(testing_support::count_occurrences(dom.out, "<figcaption>"), 8) << "4 views, the fly-through, the slices, the roles, the plot";
+  EXPECT_EQ(testing_support::count_occurrences(dom.out, "<img "), 6) << "the port, the camera, 2 exterior views, the slices, the roles";
+  EXPECT_EQ(testing_support::count_occurrences(dom.out, "class=\"strip0 player\""), 1);
   EXPECT_NE(dom.out.find("Port on the skin at (0, 110, -20) mm"), std::string::npos);
   EXPECT_NE(dom.out.find("Ports marked in yellow: umbilical_port."), std::string::npos);
-  EXPECT_EQ(count(dom.out, "<script"), 0);
+  EXPECT_EQ(testing_support::count_occurrences(dom.out, "<script"), 0);
 
   const std::string shot = dir.file("report.png");
   const testing_support::CliResult r =

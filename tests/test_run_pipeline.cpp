@@ -111,11 +111,7 @@ TEST(RunPipeline, SmallPhantomEndToEnd) {
   EXPECT_EQ(views, 4);   // the phantom scene's port and camera, two exterior views
   std::ifstream is(out / "report.html");
   const std::string html((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
-  int images = 0;
-  for (std::size_t at = html.find("data:image/png;base64,"); at != std::string::npos;
-       at = html.find("data:image/png;base64,", at + 1))
-    ++images;
-  EXPECT_EQ(images, 6);   // the roles, the slices and the 4 views
+  EXPECT_EQ(testing_support::count_occurrences(html, "data:image/png;base64,"), 6);   // the roles, the slices and the 4 views
   EXPECT_NE(html.find("<svg"), std::string::npos);
 }
 
