@@ -21,6 +21,10 @@
 //  4. No accepted tetrahedron: gas (−1000 HU, the cavity label) when the voxel is inside the space
 //     the meshes occupied before (a cube meshed at rest) or after (inside some deformed
 //     tetrahedron) deformation; otherwise the voxel keeps its own value.
+//  5. Enclosed: a voxel rule 4 kept that was outside the body at rest is gas when the deformed
+//     body encloses it in its axial slice (the space between the skin's rest place and the wall's
+//     inner face when the wall rises by more than its thickness; cavity_enclosure.h). The back ends
+//     compute rules 1–4; warp_on_device and WarpSeries apply rule 5 to every back end's result.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -85,7 +89,8 @@ WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource
 /// The device memory warp_opencl needs (bytes): what it allocates, every buffer counted.
 uint64_t warp_device_bytes(const WarpMesh& mesh, bool has_labels, const WarpBox& box);
 
-/// The stage's one entry, as solve_on_device: warp_opencl on `ctx` when given, warp_cpu otherwise.
+/// The stage's one entry, as solve_on_device: warp_opencl on `ctx` when given, warp_cpu otherwise,
+/// then rule 5 (enclose_cavity).
 WarpResult warp_on_device(ocl::Context* ctx, const WarpMesh& mesh, const WarpSource& src, const WarpBox& box,
                           const WarpOptions& opt);
 /// The same for a device spec: "cpu", "opencl" or "opencl:P:D" (InputError for anything else).

@@ -1,4 +1,4 @@
-// The plain reference of the image warp: warp.h's four rules as a loop over tetrahedra and the
+// The plain reference of the image warp: warp.h's rules 1–4 as a loop over tetrahedra and the
 // voxels of their bounding boxes, one thread, double precision, nothing precomputed. Slow (it
 // evaluates every weight of every visited voxel); it exists so that the fast CPU warp (warp_cpu.cpp:
 // tiles, cube groups, row spans solved in SSE2) and the kernel (kernels/warp.cl) have something a
