@@ -185,9 +185,14 @@ double lloyd_tet_spring_k(double young_pa, double volume_m3);
 
 /// The 4 vertex forces of pressure load l at positions x (§5): f_i = −P · cof(D_s) · c_i.
 std::array<Vec3, 4> pressure_load_forces(const Mesh& m, int64_t l, const std::vector<Vec3>& x, double pressure_pa);
-/// The gas volume the cavity faces enclose at positions x (m³), relative to `origin` (a point near
-/// them keeps the open rim's share small): −⅓ Σ_faces (x_f − origin) · n da.
-double enclosed_cavity_volume(const Mesh& m, const std::vector<Vec3>& x, const Vec3& origin);
+/// The gas volume the cavity faces enclose at positions x (m³), by the divergence theorem with a
+/// field F of divergence 1: −Σ_faces F(x_f) · n da. Exact for a closed surface whatever the field.
+/// Without `cut_normal`, F = ⅓(x − origin) (a point near the faces keeps an open rim's share small).
+/// With the unit normal of the planes where the CT's field of view cuts the cavity off (its axial
+/// slices), F = ½(I − n nᵀ)(x − origin): the field lies in those planes, so the missing caps there
+/// carry no flux and a cavity open only at the CT's cut ends is measured exactly.
+double enclosed_cavity_volume(const Mesh& m, const std::vector<Vec3>& x, const Vec3& origin,
+                              const std::optional<Vec3>& cut_normal = std::nullopt);
 /// The pressure's nodal forces at positions x (one entry per node).
 std::vector<Vec3> pressure_forces(const Mesh& m, const std::vector<Vec3>& x, double pressure_pa);
 

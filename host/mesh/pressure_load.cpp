@@ -11,13 +11,17 @@ std::array<Vec3, 4> pressure_load_forces(const Mesh& m, int64_t l, const std::ve
   return f;
 }
 
-double enclosed_cavity_volume(const Mesh& m, const std::vector<Vec3>& x, const Vec3& origin) {
-  // Σ_faces x_f · n da = Σ_i x_i · cof(F) B_i = Σ_i x_i · cof(D_s) c_i (the weights are linear).
+double enclosed_cavity_volume(const Mesh& m, const std::vector<Vec3>& x, const Vec3& origin,
+                              const std::optional<Vec3>& cut_normal) {
+  // F(x) = s·P(x − origin), div F = s·tr P = 1: P = I, s = ⅓; or P = I − n nᵀ, s = ½.
+  Mat3 sp = Mat3::Identity() / 3.0;
+  if (cut_normal) sp = 0.5 * (Mat3::Identity() - *cut_normal * cut_normal->transpose());
+  // Σ_faces F(x_f) · n da = Σ_i F(x_i) · cof(F) B_i = Σ_i F(x_i) · cof(D_s) c_i (F and the weights are linear).
   double v = 0.0;
   for (std::size_t l = 0; l < m.load_tet.size(); ++l) {
     const auto& q = m.tets[m.load_tet[l]];
     const Vec3 e1 = x[q[1]] - x[q[0]], e2 = x[q[2]] - x[q[0]], e3 = x[q[3]] - x[q[0]];
-    for (int i = 0; i < 4; ++i) v -= (x[q[i]] - origin).dot(cofactor_times(e1, e2, e3, m.load_c[l][i])) / 3.0;
+    for (int i = 0; i < 4; ++i) v -= (sp * (x[q[i]] - origin)).dot(cofactor_times(e1, e2, e3, m.load_c[l][i]));
   }
   return v;
 }

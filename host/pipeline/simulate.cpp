@@ -17,6 +17,7 @@
 #include "mesh/vtu_writer.h"
 #include "pipeline/cavity_measures.h"
 #include "pipeline/scene_stages.h"
+#include "roles/anatomical_axes.h"
 #include "report/plot_svg.h"
 #include "solve/gravity_compensation.h"
 #include "solve/solvable.h"
@@ -177,13 +178,18 @@ DeformationMetrics deformation_metrics(const Mesh& m, const std::vector<Vec3>& x
     d.mean_viscera_anterior_mm /= double(viscera);
   }
   // Gas volume: the change of the volume the cavity surfaces enclose (divergence theorem; their
-  // normals point out of their solids, into the gas). The surfaces are open where they meet fixed
-  // or unmeshed tissue; taking the rest centroid as origin keeps that rim's contribution small.
+  // normals point out of their solids, into the gas). Where the CT's first or last slice cuts the
+  // cavity off the surfaces are open; a field in the slices' planes gives those missing caps no flux
+  // (mesh.h), so that cut costs nothing (with ⅓(x − centroid) it cost a tenth of the real CT's
+  // cavity). Elsewhere the surfaces close, or open only where the wall and viscera stay bonded (the
+  // attached interfaces), whose rims move together; the rest centroid as origin keeps what is left small.
   Vec3 centroid = Vec3::Zero();
   for (int32_t t : m.load_tet)
     for (int32_t n : m.tets[t]) centroid += m.rest_m[n] / 4.0;
   if (!m.load_tet.empty()) centroid /= double(m.load_tet.size());
-  d.cavity_volume_ml = (enclosed_cavity_volume(m, x, centroid) - enclosed_cavity_volume(m, m.rest_m, centroid)) * 1e6;   // m³ → ml
+  const Vec3 axial_normal = m.grid.direction.col(anatomical_axes(m.grid).axis[2]).normalized();
+  d.cavity_volume_ml = (enclosed_cavity_volume(m, x, centroid, axial_normal) -
+                        enclosed_cavity_volume(m, m.rest_m, centroid, axial_normal)) * 1e6;   // m³ → ml
   return d;
 }
 
