@@ -40,6 +40,25 @@ TEST(CavityMeasures, GasInFrontOfTheBladderCountsOnlyInItsOwnColumn) {
   EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {99}), 0);
 }
 
+// With the intraperitoneal organs as stops, gas beyond a bowel voxel in the column (in front of
+// the bowel that lies in front of the bladder) no longer counts: a bowel voxel at y = 4 hides both,
+// one at y = 6 hides only the gas at 6 (the gas at 5 lies between the bladder and the bowel).
+TEST(CavityMeasures, GasBeyondAnIntraperitonealOrganIsNotInThePrevesicalSpace) {
+  constexpr uint16_t kBowel = 18;
+  for (const Mat3& direction : {Mat3(Mat3::Identity()), Mat3(Vec3(-1, -1, 1).asDiagonal())}) {
+    Column c(direction);
+    const bool flipped = direction(1, 1) < 0;
+    auto at = [&](int j) -> uint16_t& { return c.labels[std::size_t(c.g.linear_index(1, flipped ? 7 - j : j, 0))]; };
+    EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {kBladder}, {kBowel}), 2);
+    at(4) = kBowel;
+    EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {kBladder}, {kBowel}), 0);
+    EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {kBladder}), 2);
+    at(4) = 0;
+    at(6) = kBowel;
+    EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {kBladder}, {kBowel}), 1);
+  }
+}
+
 TEST(CavityMeasures, AGridStoredBackToFrontGivesTheSameCount) {
   Mat3 lps = Mat3::Identity();
   lps(0, 0) = -1;

@@ -8,16 +8,21 @@
 namespace pneumo {
 
 int64_t gas_voxels_anterior_to(const std::vector<uint16_t>& labels, const Geometry& g, uint16_t gas_label,
-                               const std::vector<int>& ids) {
+                               const std::vector<int>& ids, const std::vector<int>& stop_ids) {
   const SliceFrame f = slice_frame(g);
   const std::vector<int64_t> fronts = front_of_labels(labels.data(), f, LabelSet(ids));
+  const LabelSet stop(stop_ids);
   int64_t count = 0;
   for (int64_t s = 0; s < f.n_si; ++s)
     for (int64_t l = 0; l < f.n_lat; ++l) {
       const int64_t front = fronts[std::size_t(s * f.n_lat + l)];
       if (front < 0) continue;
-      for (int64_t a = 0; a < f.n_ap; ++a)
-        if (f.ant(a) > front && labels[std::size_t(f.index(l, a, s))] == gas_label) ++count;
+      // Forward from the organ's front (anteriority front + 1, …) to the first stop label.
+      for (int64_t ant = front + 1; ant < f.n_ap; ++ant) {
+        const uint16_t id = labels[std::size_t(f.index(l, f.ant(ant), s))];
+        if (stop.contains(id)) break;
+        count += id == gas_label;
+      }
     }
   return count;
 }

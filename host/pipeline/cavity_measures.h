@@ -12,10 +12,13 @@ namespace pneumo {
 
 /// Gas voxels (== gas_label) lying anterior to a voxel of one of `ids` in the same axial column
 /// (same slice, same lateral index; roles/anatomical_axes.h): on the deformed labels with the
-/// bladder's id, the prevesical space, where no gas should open (it is extraperitoneal). Counts
-/// voxels; 0 when no listed id is present.
+/// bladder's id, gas in front of the bladder. Counts voxels; 0 when no listed id is present.
+/// With `stop_ids` (the intraperitoneal organs), the column is followed forward from the organ's
+/// front only until a voxel of one of them: gas beyond a bowel loop that lies in front of the
+/// bladder's upper part is in the peritoneal cavity, gas short of it is in the prevesical space
+/// (the space of Retzius, extraperitoneal), where none should open.
 int64_t gas_voxels_anterior_to(const std::vector<uint16_t>& labels, const Geometry& g, uint16_t gas_label,
-                               const std::vector<int>& ids);
+                               const std::vector<int>& ids, const std::vector<int>& stop_ids = {});
 
 /// The mean posterior displacement (mm, positive = towards the back) of the viscera nodes in the
 /// anterior half of the viscera's rest extent from back to front (world y, RAS): where the gas lies

@@ -264,13 +264,18 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
                                  {"below_ml", scene.output.min_cavity_piece_ml}};
     j["cavity_outside_largest_piece_fraction"] =
         w.cavity_voxels() > 0 ? 1.0 - double(largest) / double(w.cavity_voxels()) : 0.0;
-    // Gas in front of the extraperitoneal organs the roles keep attached (the bladder: the space of
-    // Retzius), in the deformed frame.
-    if (!scene.roles.auto_prevesical_labels.empty())
+    // Gas in front of the extraperitoneal organs the roles keep attached (the bladder), in the
+    // deformed frame: all of it, and the part with no intraperitoneal organ between it and the
+    // bladder (the space of Retzius, where none should open).
+    if (!scene.roles.auto_prevesical_labels.empty()) {
+      const uint16_t gas_id = uint16_t(scene.output.cavity_label);
+      const auto& bladder = scene.roles.auto_prevesical_labels;
       j["gas_anterior_to_prevesical_labels_ml"] =
-          double(gas_voxels_anterior_to(w.result.labels, w.output_grid, uint16_t(scene.output.cavity_label),
-                                        scene.roles.auto_prevesical_labels)) *
+          double(gas_voxels_anterior_to(w.result.labels, w.output_grid, gas_id, bladder)) * w.voxel_volume_ml;
+      j["gas_in_prevesical_space_ml"] =
+          double(gas_voxels_anterior_to(w.result.labels, w.output_grid, gas_id, bladder, scene.roles.viscera_labels)) *
           w.voxel_volume_ml;
+    }
   }
   j["warp"] = {{"device", w.result.device},
                {"cavity_label", scene.output.cavity_label},
