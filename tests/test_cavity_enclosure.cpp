@@ -30,17 +30,9 @@ constexpr int64_t kViscTop = 8, kWallTop = 11;   // viscera j < 8, wall 8 ≤ j 
 /// The lift of the wall (index units along +j) at index x: zero at the wall's ends (x = 1.5, 21.5).
 double lift_at(double x) { return kLiftVoxels * std::sin(M_PI * (x - 1.5) / 20.0); }
 
-struct Slab {
-  Geometry grid;
-  std::vector<Role> roles;
-  std::vector<uint16_t> labels;
-  std::vector<float> ct;
-  Mesh mesh;
-  WarpSource source() const { return WarpSource{ct.data(), labels.data(), roles.data()}; }
-};
-
-Slab make_slab(int cube) {
-  Slab s;
+/// warp_test_support.h's case, laid out by hand: a slab of wall over a block of viscera.
+WarpCase make_slab(int cube) {
+  WarpCase s;
   s.grid = grid_of({kNi, kNj, kNk}, {1.0, 1.0, 1.0}, Mat3::Identity());
   const int64_t n = s.grid.voxel_count();
   s.roles.assign(std::size_t(n), Role::Other);
@@ -62,7 +54,7 @@ Slab make_slab(int cube) {
 }
 
 /// The wall's nodes lifted along +j by lift_at(their i), the viscera's left in place.
-WarpMesh lifted(const Slab& s) {
+WarpMesh lifted(const WarpCase& s) {
   std::vector<Vec3> u(std::size_t(s.mesh.node_count()), Vec3::Zero());
   for (int64_t n = 0; n < s.mesh.node_count(); ++n) {
     if (s.mesh.node_part[std::size_t(n)] != Part::Wall) continue;
@@ -97,7 +89,7 @@ class CavityEnclosure : public QuietWarpTest {};
 TEST_F(CavityEnclosure, GasFillsTheSpaceUnderAWallLiftedBeyondItsThicknessAtEveryCubeSize) {
   for (int cube : {1, 2}) {
     SCOPED_TRACE("cube " + std::to_string(cube));
-    const Slab s = make_slab(cube);
+    const WarpCase s = make_slab(cube);
     const WarpMesh m = lifted(s);
     const WarpBox box{{0, 0, 0}, s.grid.dims};
     const WarpResult back_end = warp_cpu(m, s.source(), box, options());
