@@ -274,10 +274,13 @@ TEST(RolesAuto, FindsThePhantomsWallWithoutWallLabels) {
 }
 
 TEST(RolesAuto, TissueInFrontOfThePrevesicalLabelsJoinsTheWall) {
-  // Compared: the torso with a "bladder" (label 21, a 12 mm sphere at x = 0, y = −10 mm, listed as wall)
-  // and roles.auto_prevesical_labels = [21], against rule 5b: the core tissue anterior to the sphere in its
-  // own columns (x = 0, y = 30 mm: between it and the shell) becomes wall; the same tissue beside the sphere's
-  // columns (x = 40 mm) and behind it (y = −40 mm) stays viscera; without the key it is all viscera.
+  // Compared: the torso with a "bladder" (label 21, a 12 mm sphere at x = 0, y = −10 mm, z = 22.5 mm, listed
+  // as wall) and roles.auto_prevesical_labels = [21], against rules 5b and 6b: the core tissue anterior to the
+  // sphere in its own columns (x = 0, y = 30 mm: between it and the shell) becomes wall; so does the tissue
+  // beside those columns (x = 40 and 60 mm) in slices from the sphere's top (z = 34.5 mm) down, anterior to its back
+  // (y = −22 mm in its mid slice), and below the sphere (z = 5 mm: its lowest slice's back); above its top
+  // (z = 40 mm) and behind it (y = −40 mm) the tissue stays as without the key; without the key it is all
+  // viscera.
   Progress::set_enabled(false);
   const Volume ct = torso(kIso);
   Volume labels(kIso, VoxelType::UInt8);
@@ -292,7 +295,12 @@ TEST(RolesAuto, TissueInFrontOfThePrevesicalLabelsJoinsTheWall) {
   const RoleVolume with = assign_roles(s, ct, &labels);
   EXPECT_EQ(role_at(without, {0, 30, 22.5}), Role::Viscera);
   EXPECT_EQ(role_at(with, {0, 30, 22.5}), Role::Wall);
-  EXPECT_EQ(role_at(with, {40, 30, 22.5}), Role::Viscera);
+  EXPECT_EQ(role_at(without, {40, 30, 22.5}), Role::Viscera);
+  EXPECT_EQ(role_at(with, {40, 30, 22.5}), Role::Wall);
+  EXPECT_EQ(role_at(with, {60, 0, 22.5}), Role::Wall);
+  EXPECT_EQ(role_at(with, {60, 0, 5}), Role::Wall);
+  EXPECT_EQ(role_at(without, {40, 30, 40}), Role::Viscera);
+  EXPECT_EQ(role_at(with, {40, 30, 40}), Role::Viscera);
   EXPECT_EQ(role_at(with, {0, -40, 22.5}), role_at(without, {0, -40, 22.5}));
   EXPECT_EQ(role_at(with, {0, -10, 22.5}), Role::Wall);   // the sphere itself, by its label
 }

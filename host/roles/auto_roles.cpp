@@ -7,6 +7,7 @@
 
 #include "core/log.h"
 #include "core/progress.h"
+#include "domain/label_set.h"
 #include "roles/anatomical_axes.h"
 #include "roles/back_region.h"
 #include "roles/body_mask.h"
@@ -121,6 +122,43 @@ void attach_prevesical_space(std::vector<Role>& role, const uint16_t* label, con
     }
 }
 
+/// Rule 6b: below the peritoneal reflection at the dome of the prevesical labels, undecided voxels
+/// anterior to the organ's back in their slice → wall (auto_roles.h).
+void attach_below_the_reflection(std::vector<Role>& role, const uint16_t* label, const Geometry& g,
+                                 const SliceFrame& f, const RoleRules& r) {
+  if (!label || r.auto_prevesical_labels.empty()) return;
+  const LabelSet organ(r.auto_prevesical_labels);
+  // The organ's back (least anteriority) in each slice, -1 where the slice holds none of it.
+  std::vector<int64_t> back(static_cast<std::size_t>(f.n_si), -1);
+#pragma omp parallel for schedule(static)
+  for (int64_t s = 0; s < f.n_si; ++s)
+    for (int64_t a = 0; a < f.n_ap && back[s] < 0; ++a)
+      for (int64_t l = 0; l < f.n_lat; ++l)
+        if (organ.contains(label[f.index(l, f.ant(a), s)])) {
+          back[s] = a;
+          break;
+        }
+  // Slices in superior order: the first holding the organ from the top is its dome; below it, a
+  // slice without the organ takes the back of the nearest slice above that has one.
+  const int up = anatomical_axes(g).sign[2];
+  std::vector<int64_t> order(static_cast<std::size_t>(f.n_si));
+  for (int64_t s = 0; s < f.n_si; ++s) order[s] = up > 0 ? f.n_si - 1 - s : s;   // top first
+  int64_t carried = -1;
+  for (int64_t s : order) {
+    if (back[s] >= 0) carried = back[s];
+    else back[s] = carried;   // -1 above the dome
+  }
+#pragma omp parallel for schedule(static)
+  for (int64_t s = 0; s < f.n_si; ++s) {
+    if (back[s] < 0) continue;
+    for (int64_t a = back[s] + 1; a < f.n_ap; ++a)
+      for (int64_t l = 0; l < f.n_lat; ++l) {
+        const int64_t v = f.index(l, f.ant(a), s);
+        if (role[v] == kUndecided) role[v] = Role::Wall;
+      }
+  }
+}
+
 /// Rule 6: undecided voxels lateral to bone (away from the midline) → fixed.
 void fix_lateral_to_bone(std::vector<Role>& role, const std::vector<uint8_t>& body, const float* hu,
                          const std::vector<SliceCentre>& centres, const SliceFrame& f, const RoleRules& r) {
@@ -160,6 +198,7 @@ std::vector<Role> auto_roles(const RoleRules& r, const Geometry& g, const float*
   timer.done(4, "wall shell");
 
   fix_lateral_to_bone(role, body, hu, centres, f, r);
+  if (r.auto_use_labels) attach_below_the_reflection(role, label, g, f, r);
   timer.done(5, "lateral to bone");
 
   const int64_t n = int64_t(role.size());

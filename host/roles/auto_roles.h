@@ -17,6 +17,12 @@
 //      in front of the bladder (docs/fidelity.md);
 //   6. deeper tissue lateral to bone that is at least 40 mm from the midline (hip joints, iliac
 //      wings, pubic rami: the gluteal, hip and thigh muscles) → fixed (lateral_to_bone.h);
+//   6b. with auto_use_labels and a label map: in the axial slices from the top (dome) of the
+//      auto_prevesical_labels down, undecided tissue anterior to the organ's back in that slice
+//      (below its lowest slice, its back there) → wall. The peritoneum covers the bladder's dome
+//      and reflects from it onto the anterior wall; below that only the pouch behind the bladder is
+//      peritoneal: the prevesical and paravesical spaces and the groin in front of the hips are
+//      extraperitoneal (on the real CT gas opened there in pockets apart from the cavity);
 //   7. everything else in the body → viscera.
 // Limits, stated so nobody trusts more than this:
 //   - The wall is a shell of uniform thickness, not the real skin/fat/muscle layers: where the wall
@@ -35,8 +41,9 @@
 //   - No diaphragm: without labels, the thorax's contents (aerated lung, filled in as a hole, and the
 //     heart) become viscera. With the lungs and heart labelled fixed (TotalSegmentator has them) the
 //     back rule's run continues from the spine through the heart, and thoracic slices are held.
-//   - Below the pelvic brim the rules are rough: tissue in front of the pubic rami in rows without
-//     bone (the inguinal region, the front of the thighs) becomes viscera.
+//   - Below the pelvic brim the rules are rough: without a bladder label (rule 6b), tissue in front
+//     of the pubic rami in rows without bone (the inguinal region, the front of the thighs) becomes
+//     viscera.
 #include <cstdint>
 #include <vector>
 

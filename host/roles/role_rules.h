@@ -20,7 +20,8 @@ struct RoleRules {
   bool auto_use_labels = true;
   // Extraperitoneal organs whose front the peritoneum does not reach (the bladder: the space of
   // Retzius lies between it and the wall): undecided tissue anterior to them in the same axial
-  // column becomes wall, so no gas opens there (auto_roles.h, rule 5b).
+  // column becomes wall, so no gas opens there (auto_roles.h, rule 5b), and in the slices from
+  // their top down, undecided tissue anterior to their back (rule 6b: below the reflection).
   std::vector<int> auto_prevesical_labels;
   // Air added around the CT so the wall has room to rise (a 12 mmHg abdomen rises 30-60 mm).
   double pad_anterior_mm = 0.0, pad_lateral_mm = 0.0, pad_superior_mm = 0.0, pad_inferior_mm = 0.0;
