@@ -72,9 +72,11 @@ TEST(Cli, ThreadsSetsPoclsCpuDeviceAndIsBounded) {
     auto r = run_pneumo("devices --json --threads " + std::to_string(n));
     ASSERT_EQ(r.code, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
-    for (std::size_t i = 1; i < j.size(); ++i)
-      if (j[i]["platform"].get<std::string>().find("Portable Computing Language") != std::string::npos)
+    for (std::size_t i = 1; i < j.size(); ++i) {
+      if (j[i]["platform"].get<std::string>().find("Portable Computing Language") != std::string::npos) {
         EXPECT_EQ(j[i]["compute_units"], n) << j[i].dump();
+      }
+    }
   }
   for (const char* bad : {"0", "-2", "1025", "two"}) {
     auto r = run_pneumo(std::string("--threads ") + bad + " devices");

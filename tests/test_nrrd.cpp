@@ -59,7 +59,7 @@ void expect_same_volume(const Volume& a, const Volume& b, double tol_mm) {
 TEST(Nrrd, ItkReadsPneumosNrrdAndPneumoReadsItks) {
   ScratchDir d;
   write_volume(oblique_ramp(VoxelType::Int16), d.file("oblique.nii.gz"));
-  for (const std::string source : {kRealCt, d.file("oblique.nii.gz")}) {
+  for (const std::string& source : {kRealCt, d.file("oblique.nii.gz")}) {
     SCOPED_TRACE(source);
     const Volume original = read_volume(source);
     // pneumo writes NRRD, ITK reads it and writes NIfTI, pneumo reads that.
