@@ -11,16 +11,7 @@
 
 #include "core/atomic_file.h"
 
-// Static linkage: another part of pneumo may include stb_image_write for itself without the two
-// implementations clashing at link time.
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#define STB_IMAGE_WRITE_STATIC
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#include <stb/stb_image_write.h>
-#pragma GCC diagnostic pop
+#include <stb/stb_image_write.h>   // its implementation: stb_image_write_impl.cpp
 
 namespace pneumo {
 
