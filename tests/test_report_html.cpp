@@ -38,8 +38,8 @@ TEST(ReportHtml, EmbedsImagesAndPlotsAndReferencesNothingOutside) {
                {"stage_seconds", {{"solve", 1.5}}}, {"pressure_curve", {{{"pressure_mmhg", 5}, {"cavity_volume_ml", 284}}}}};
   c.scene = {{"load", {{"pressure_mmhg", 12}}}};
   c.plots.push_back({"convergence", "<?xml version=\"1.0\"?><svg xmlns=\"http://www.w3.org/2000/svg\"></svg>"});
-  c.images.push_back({"view", png});
-  c.images.push_back({"gone", dir.file("missing.png")});
+  c.images.push_back({"view", png, ""});
+  c.images.push_back({"gone", dir.file("missing.png"), ""});
   const std::string html = report_html(c);
   EXPECT_NE(html.find("data:image/png;base64," + base64(bytes)), std::string::npos);
   EXPECT_NE(html.find("<svg xmlns"), std::string::npos);
