@@ -102,3 +102,22 @@ TEST(CavityVolume, DeformationMetricsFindTheAxialCutInAnyGridLayout) {
     EXPECT_NEAR(deformation_metrics(m, lifted(m, lay)).cavity_volume_ml, exact_gas_ml(), 1e-9 * exact_gas_ml());
   }
 }
+
+// The viscera's tissue volume change (deformation_metrics' viscera_volume_change_ml): zero under a
+// translation, (s³ − 1) × their volume under a uniform scaling by s; the slab's viscera fill 4 slices
+// × 4 × 20 voxels of 1 mm³ whole, so their volume is 0.32 ml. Rounding only: 1e-9 relative.
+TEST(CavityVolume, VisceraVolumeChangeIsZeroWhenMovedAndExactWhenScaled) {
+  const Layout ras;
+  const Mesh m = slab_mesh(ras);
+  const double viscera_ml = double(kNSi) * 4.0 * double(kNLat - 4) / 1000.0;   // mm³ → ml
+  ASSERT_NEAR(viscera_ml, 0.32, 1e-12);
+  std::vector<Vec3> moved = m.rest_m, scaled = m.rest_m;
+  const double s = 1.1;
+  for (std::size_t n = 0; n < moved.size(); ++n) {
+    moved[n] += Vec3(0.003, -0.002, 0.010);
+    scaled[n] *= s;
+  }
+  EXPECT_NEAR(deformation_metrics(m, moved).viscera_volume_change_ml, 0.0, 1e-9 * viscera_ml);
+  EXPECT_NEAR(deformation_metrics(m, scaled).viscera_volume_change_ml, (s * s * s - 1.0) * viscera_ml,
+              1e-9 * viscera_ml);
+}

@@ -177,6 +177,12 @@ DeformationMetrics deformation_metrics(const Mesh& m, const std::vector<Vec3>& x
     d.mean_viscera_displacement_mm /= double(viscera);
     d.mean_viscera_anterior_mm /= double(viscera);
   }
+  for (int64_t t = 0; t < int64_t(m.tets.size()); ++t) {
+    if (m.tet_part[t] != Part::Viscera) continue;
+    const auto& q = m.tets[t];
+    const double v = signed_tet_volume(x[q[0]], x[q[1]], x[q[2]], x[q[3]]);
+    d.viscera_volume_change_ml += m.tet_fraction[t] * (v - m.tet_rest_volume_m3[t]) * 1e6;   // m³ → ml
+  }
   // Gas volume: the change of the volume the cavity surfaces enclose (divergence theorem; their
   // normals point out of their solids, into the gas). Where the CT's first or last slice cuts the
   // cavity off the surfaces are open; a field in the slices' planes gives those missing caps no flux
@@ -230,6 +236,7 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   j["anterior_viscera_posterior_motion_mm"] = mean_posterior_motion_of_anterior_viscera_mm(sim.mesh, r.x);
   j["max_fixed_displacement_mm"] = d.max_fixed_displacement_mm;
   j["cavity_volume_ml"] = d.cavity_volume_ml;
+  j["viscera_volume_change_ml"] = d.viscera_volume_change_ml;
   j["inverted_tetrahedra"] = r.inverted_tetrahedra;
   if (sim.gravity.done)
     j["gravity_compensation"] = {{"sag_mm", sim.gravity.sag_mm}, {"error_mm", sim.gravity.error_mm},

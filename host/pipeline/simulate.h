@@ -72,6 +72,9 @@ struct DeformationMetrics {
   double max_wall_displacement_mm = 0, mean_wall_displacement_mm = 0, anterior_rise_mm = 0;
   double mean_viscera_displacement_mm = 0, mean_viscera_anterior_mm = 0;
   double cavity_volume_ml = 0;
+  /// Change of the viscera's tissue volume, Σ fraction × (V − V_rest) over their tetrahedra: what
+  /// they give up to the gas (negative when compressed). Nearly incompressible viscera keep it near 0.
+  double viscera_volume_change_ml = 0;
   double max_fixed_displacement_mm = 0;
 };
 DeformationMetrics deformation_metrics(const Mesh& m, const std::vector<Vec3>& x);
