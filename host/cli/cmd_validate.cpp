@@ -79,12 +79,12 @@ Run add_validate(CLI::App& app) {
         std::cout << to_json(s).dump(2) << "\n";
         return 0;
       }
-      std::printf("%-6s %-8s %-10s %-12s %-12s %-9s %-8s %s\n", "cube", "cube_mm", "rise_mm", "cavity_ml", "wall_mean_mm",
-                  "nodes", "inverted", "converged");
+      std::printf("%-6s %-8s %-10s %-12s %-12s %-12s %-9s %-8s %s\n", "cube", "cube_mm", "rise_mm", "cavity_ml",
+                  "wall_mean_mm", "viscera_back", "nodes", "inverted", "converged");
       for (const ConvergenceRow& r : s.rows)
-        std::printf("%-6d %-8.1f %-10.2f %-12.1f %-12.2f %-9lld %-8lld %s\n", r.cube_voxels, r.cube_mm, r.anterior_rise_mm,
-                    r.cavity_volume_ml, r.mean_wall_displacement_mm, (long long)r.nodes, (long long)r.inverted,
-                    r.converged ? "yes" : "no");
+        std::printf("%-6d %-8.1f %-10.2f %-12.1f %-12.2f %-12.2f %-9lld %-8lld %s\n", r.cube_voxels, r.cube_mm,
+                    r.anterior_rise_mm, r.cavity_volume_ml, r.mean_wall_displacement_mm, r.viscera_posterior_motion_mm,
+                    (long long)r.nodes, (long long)r.inverted, r.converged ? "yes" : "no");
       auto line = [](const char* what, const ObservedOrder& oo) {
         if (oo.monotone) std::printf("%s: observed order %.2f, extrapolated %.2f\n", what, oo.order, oo.extrapolated);
         else
@@ -94,6 +94,7 @@ Run add_validate(CLI::App& app) {
       line("rise", s.rise);
       line("cavity", s.volume);
       line("wall mean", s.wall);
+      line("viscera back (posterior motion of their anterior half)", s.viscera);
       std::printf("change between the two finest sizes: rise %.1f %%, cavity %.1f %%\n", 100 * s.finest_change_rise,
                   100 * s.finest_change_volume);
       return 0;

@@ -5,6 +5,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "pipeline/cavity_measures.h"
 #include "pipeline/simulate.h"
 #include "solve/forces.h"
 
@@ -46,7 +47,7 @@ ConvergenceStudy convergence_study(const Scene& scene, const std::vector<int>& c
       throw InputError("validate convergence: list --cube-voxels from coarse to fine (decreasing), e.g. 4,3,2,1");
   }
   ConvergenceStudy s;
-  std::vector<double> h, rise, volume, wall;
+  std::vector<double> h, rise, volume, wall, viscera;
   for (const int L : cube_voxels) {
     Scene sc = scene;
     sc.mesh.cube_mm.reset();
@@ -60,6 +61,7 @@ ConvergenceStudy convergence_study(const Scene& scene, const std::vector<int>& c
     r.anterior_rise_mm = d.anterior_rise_mm;
     r.cavity_volume_ml = d.cavity_volume_ml;
     r.mean_wall_displacement_mm = d.mean_wall_displacement_mm;
+    r.viscera_posterior_motion_mm = mean_posterior_motion_of_anterior_viscera_mm(sim.mesh, sim.result.x);
     r.nodes = sim.mesh.node_count();
     r.inverted = count_inverted(sim.mesh, sim.result.x);
     r.steps = sim.result.steps;
@@ -70,10 +72,12 @@ ConvergenceStudy convergence_study(const Scene& scene, const std::vector<int>& c
     rise.push_back(r.anterior_rise_mm);
     volume.push_back(r.cavity_volume_ml);
     wall.push_back(r.mean_wall_displacement_mm);
+    viscera.push_back(r.viscera_posterior_motion_mm);
   }
   s.rise = observed_order(h, rise);
   s.volume = observed_order(h, volume);
   s.wall = observed_order(h, wall);
+  s.viscera = observed_order(h, viscera);
   const std::size_t n = s.rows.size();
   auto change = [&](double coarse, double fine) { return fine != 0.0 ? std::abs(coarse - fine) / std::abs(fine) : 0.0; };
   s.finest_change_rise = change(rise[n - 2], rise[n - 1]);
@@ -89,6 +93,7 @@ nlohmann::json to_json(const ConvergenceStudy& s) {
                     {"anterior_rise_mm", r.anterior_rise_mm},
                     {"cavity_volume_ml", r.cavity_volume_ml},
                     {"mean_wall_displacement_mm", r.mean_wall_displacement_mm},
+                    {"anterior_viscera_posterior_motion_mm", r.viscera_posterior_motion_mm},
                     {"nodes", r.nodes},
                     {"inverted_tetrahedra", r.inverted},
                     {"steps", r.steps},
@@ -103,6 +108,7 @@ nlohmann::json to_json(const ConvergenceStudy& s) {
           {"anterior_rise_mm", order(s.rise)},
           {"cavity_volume_ml", order(s.volume)},
           {"mean_wall_displacement_mm", order(s.wall)},
+          {"anterior_viscera_posterior_motion_mm", order(s.viscera)},
           {"finest_change_rise", s.finest_change_rise},
           {"finest_change_volume", s.finest_change_volume}};
 }

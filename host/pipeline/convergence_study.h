@@ -14,6 +14,7 @@ struct ConvergenceRow {
   int cube_voxels = 0;
   double cube_mm = 0;                 // L × the CT's largest spacing
   double anterior_rise_mm = 0, cavity_volume_ml = 0, mean_wall_displacement_mm = 0;
+  double viscera_posterior_motion_mm = 0;   // mean over the viscera's anterior half (cavity_measures.h)
   int64_t nodes = 0, inverted = 0, steps = 0;
   bool converged = false;
   double solve_seconds = 0;
@@ -30,7 +31,7 @@ ObservedOrder observed_order(const std::vector<double>& h, const std::vector<dou
 
 struct ConvergenceStudy {
   std::vector<ConvergenceRow> rows;   // in the order given: coarse to fine
-  ObservedOrder rise, volume, wall;
+  ObservedOrder rise, volume, wall, viscera;
   /// Largest change of rise and volume between the two finest sizes, relative to the finest.
   double finest_change_rise = 0, finest_change_volume = 0;
 };
