@@ -69,3 +69,22 @@ TEST(ScenePresets, CubeMmGivesTheNearestWholeVoxelsAlongTheCoarsestAxis) {
   m.cube_mm = 0.2;
   EXPECT_EQ(cube_voxels_for(m, g), 1);   // at least one voxel
 }
+
+TEST(ScenePresets, TheFiniteElementsTakeNewtonAtEveryPreset) {
+  // The springs keep each preset's measured solver; the finite elements take Newton, where the static
+  // solver did not finish or diverged on the real CT (scene_presets.cpp). A solver the scene names wins.
+  for (const ScenePreset p : {ScenePreset::Preview, ScenePreset::Balanced, ScenePreset::Accurate}) {
+    SCOPED_TRACE(enum_name(p));
+    for (const char* model : {"fem-corotational", "fem-neohookean"}) {
+      const Scene s = parse_scene(json{{"preset", enum_name(p)}, {"material", {{"model", model}}}}, kOrigin);
+      EXPECT_EQ(s.solver.method, SolverMethod::Newton) << model;
+      EXPECT_EQ(*s.mesh.cube_mm, preset_settings(p).cube_mm);
+    }
+    const Scene springs = parse_scene(json{{"preset", enum_name(p)}, {"material", {{"model", "msd"}}}}, kOrigin);
+    EXPECT_EQ(springs.solver.method, preset_settings(p).method);
+    const Scene told = parse_scene(
+        json{{"preset", enum_name(p)}, {"material", {{"model", "fem-neohookean"}}}, {"solver", {{"method", "static"}}}},
+        kOrigin);
+    EXPECT_EQ(told.solver.method, SolverMethod::Static);
+  }
+}

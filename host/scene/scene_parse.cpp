@@ -173,7 +173,13 @@ Scene parse_scene(const nlohmann::json& j, const std::string& origin_path) {
   // A misspelt preset is left to the table, which names the allowed values.
   nlohmann::json merged = j;
   if (const std::optional<ScenePreset> p = find_preset(j); p && *p != ScenePreset::None) {
-    merged = preset_patch(*p);
+    // The solver follows the material model the scene names (a misspelt one is left to the table).
+    MaterialModel model = MaterialModel::Msd;
+    if (const auto m = j.find("material"); m != j.end() && m->is_object())
+      if (const auto name = m->find("model"); name != m->end() && name->is_string())
+        for (std::size_t i = 0; i < EnumNames<MaterialModel>::names.size(); ++i)
+          if (*name == EnumNames<MaterialModel>::names[i]) model = MaterialModel(i);
+    merged = preset_patch(*p, model);
     merged.merge_patch(j);
   }
   scene_detail::scene_table().read(s, merged, scene_detail::At{&ctx, ""});

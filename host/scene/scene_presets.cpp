@@ -15,9 +15,17 @@ namespace {
 // < 0.03 mm at every cube size, and the dynamic schemes reached the same error as the static solver at the same
 // cube size in 10-100× the time. "accurate" keeps 1e-3 (same error there, +0.8 s) as a margin for cases stiffer or
 // more nonlinear than the phantom. The texts say what each measured to buy (solve time, RMS / max error).
-const PresetSettings kPreview{SolverMethod::Static, 12.0, 1e-2, "measured: solve 0.17 s, error RMS 2.5 mm, max 7.5 mm"};
-const PresetSettings kBalanced{SolverMethod::Static, 9.0, 1e-2, "measured: solve 0.41 s, error RMS 1.7 mm, max 5.4 mm"};
-const PresetSettings kAccurate{SolverMethod::Static, 6.0, 1e-3, "measured: solve 3.1 s, error RMS 0.63 mm, max 2.1 mm"};
+//
+// The finite elements take Newton at every preset (bench/results/2026-12-02-material-models.md, the real CT): the
+// static solver (FIRE) did not finish within 300 s at 9 and 6 mm cubes, where Newton took 61 and 190 s, and on the
+// FEM example scene with its soft, compressible viscera it diverges at 12 mm cubes where Newton converges in 15
+// iterations (docs/fem.md). The solver follows the model; the model stays the scene's physics.
+const PresetSettings kPreview{SolverMethod::Static, SolverMethod::Newton, 12.0, 1e-2,
+                              "measured: solve 0.17 s, error RMS 2.5 mm, max 7.5 mm"};
+const PresetSettings kBalanced{SolverMethod::Static, SolverMethod::Newton, 9.0, 1e-2,
+                               "measured: solve 0.41 s, error RMS 1.7 mm, max 5.4 mm"};
+const PresetSettings kAccurate{SolverMethod::Static, SolverMethod::Newton, 6.0, 1e-3,
+                               "measured: solve 3.1 s, error RMS 0.63 mm, max 2.1 mm"};
 
 }  // namespace
 
@@ -31,10 +39,14 @@ const PresetSettings& preset_settings(ScenePreset p) {
   throw std::invalid_argument("preset \"none\" has no settings");
 }
 
-nlohmann::json preset_patch(ScenePreset p) {
+SolverMethod preset_method(const PresetSettings& s, MaterialModel model) {
+  return model == MaterialModel::Msd ? s.method : s.fem_method;
+}
+
+nlohmann::json preset_patch(ScenePreset p, MaterialModel model) {
   const PresetSettings& s = preset_settings(p);
   return {{"mesh", {{"cube_mm", s.cube_mm}}},
-          {"solver", {{"method", enum_name(s.method)}, {"residual_tolerance", s.residual_tolerance}}}};
+          {"solver", {{"method", enum_name(preset_method(s, model))}, {"residual_tolerance", s.residual_tolerance}}}};
 }
 
 std::optional<ScenePreset> find_preset(const nlohmann::json& scene) {
@@ -51,8 +63,9 @@ const std::string& preset_reference_text() {
   static const std::string text = [] {
     std::string t = "Speed against accuracy, measured by `pneumo bench` (docs/performance.md, bench/results/2026-11-23-bench.md: the "
                     "medium phantom, CPU 1 thread, error at skin and cavity points against 4.5 mm cubes): sets "
-                    "mesh.cube_mm, solver.method and solver.residual_tolerance unless the scene gives them. "
-                    "\"none\": the defaults.";
+                    "mesh.cube_mm, solver.method and solver.residual_tolerance unless the scene gives them; the finite "
+                    "elements (material.model fem-*) take newton at every preset, where the static solver did not "
+                    "finish or diverged on the real CT (docs/fem.md). \"none\": the defaults.";
     for (const ScenePreset p : {ScenePreset::Preview, ScenePreset::Balanced, ScenePreset::Accurate}) {
       const PresetSettings& s = preset_settings(p);
       char b[256];

@@ -14,7 +14,8 @@
 namespace pneumo {
 
 struct PresetSettings {
-  SolverMethod method = SolverMethod::Static;
+  SolverMethod method = SolverMethod::Static;       // for the springs (material.model "msd")
+  SolverMethod fem_method = SolverMethod::Newton;   // for the finite elements
   double cube_mm = 9.0;
   double residual_tolerance = 1e-3;
   const char* measured = "";   // what the committed benchmark measured it to buy (for the reference)
@@ -23,8 +24,12 @@ struct PresetSettings {
 /// The settings of a preset other than None (std::invalid_argument for None).
 const PresetSettings& preset_settings(ScenePreset p);
 
-/// {"mesh": {"cube_mm": …}, "solver": {"method": …, "residual_tolerance": …}}: what parsing merges under the scene.
-nlohmann::json preset_patch(ScenePreset p);
+/// The solver a preset picks for a material model: the springs' `method`, the finite elements' `fem_method`.
+SolverMethod preset_method(const PresetSettings& s, MaterialModel model);
+
+/// {"mesh": {"cube_mm": …}, "solver": {"method": …, "residual_tolerance": …}}: what parsing merges under a scene
+/// whose material.model is `model`.
+nlohmann::json preset_patch(ScenePreset p, MaterialModel model);
 
 /// The preset a scene's JSON names, when it names a known one (top-level "preset").
 std::optional<ScenePreset> find_preset(const nlohmann::json& scene);
