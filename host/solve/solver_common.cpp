@@ -224,7 +224,8 @@ void Monitor::check_finite_forces(double residual, int64_t step) const {
   std::ostringstream os;
   os << r_.solver << " diverged at step " << step
      << " (non-finite forces): a material value that makes them overflow or vanish (material.young_kpa and its "
-        "overrides, spring_scale, density_kg_m3) or the load; check them";
+        "overrides, spring_scale, density_kg_m3) or the load; check them. With the finite elements (material.model "
+        "fem-*), the static and explicit schemes can diverge where solver.method \"newton\" converges";
   throw DivergedError(os.str(), r_.dt_stable_s);
 }
 
