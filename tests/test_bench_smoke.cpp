@@ -116,6 +116,11 @@ TEST(BenchSmoke, QuickRunWritesEverySectionWithFiniteNumbers) {
   ASSERT_EQ(mm["throughput"]["rows"].size(), c["devices"].size());   // every device the throughput measured
   for (const json& row : mm["throughput"]["rows"]) EXPECT_GT(row["evaluate_element_updates_per_s"].get<double>(), 0);
   EXPECT_EQ(mm["choice"].size(), 3u);
+  for (const json& c : mm["choice"]) {   // per preset: the solver it takes for each model (scene_presets.h)
+    ASSERT_EQ(c["models"].size(), 2u) << c.dump();
+    EXPECT_EQ(c["models"][1]["model"], "fem-neohookean");
+    EXPECT_EQ(c["models"][1]["preset_solver"], "newton");
+  }
 
   EXPECT_NE(slurp(md).find("## Speed against accuracy"), std::string::npos);
   EXPECT_NE(slurp(md).find("## Material models"), std::string::npos);

@@ -195,15 +195,19 @@ void material_models(std::ostringstream& md, const json& mm) {
        << (r.contains("evaluate_fraction_of_triad") ? num(r["evaluate_fraction_of_triad"], "%.2f") : "–") << " | "
        << (r.contains("product_fraction_of_triad") ? num(r["product_fraction_of_triad"], "%.2f") : "–") << " |\n";
   md << "\nPeer: " << t["peer"]["source"].get<std::string>() << " (" << t["peer"]["comparable"].get<std::string>()
-     << ").\n\nWhich model for which preset (" << mm["choice_rule"].get<std::string>() << "):\n\n";
+     << ").\n\nWhich solver for which preset (" << mm["choice_rule"].get<std::string>() << "):\n\n";
   for (const auto& c : mm["choice"]) {
-    md << "- **" << c["preset"].get<std::string>() << "**: ";
-    if (c["chosen"].is_null()) md << "no real-CT row in this run\n";
-    else
-      md << c["chosen"]["model"].get<std::string>() << " with " << c["chosen"]["solver"].get<std::string>() << ", "
-         << num(c["chosen"]["wall_s"], "%.1f") << " s, Lamé error "
-         << num(json(100 * c["chosen"]["lame_error"].get<double>()), "%.1f") << " %; the preset today: "
-         << c["preset_model"].get<std::string>() << "\n";
+    md << "- **" << c["preset"].get<std::string>() << "**:";
+    for (const auto& m : c["models"]) {
+      md << " " << m["model"].get<std::string>() << ": ";
+      if (m["fastest"].is_null()) md << "no converged real-CT row in this run";
+      else
+        md << m["fastest"]["solver"].get<std::string>() << " fastest (" << num(m["fastest"]["wall_s"], "%.1f")
+           << " s), the preset takes " << m["preset_solver"].get<std::string>()
+           << (m["follows"].get<bool>() ? " (follows)" : " (does not follow)");
+      md << ";";
+    }
+    md << "\n";
   }
   md << "\n";
 }

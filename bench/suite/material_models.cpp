@@ -11,6 +11,7 @@
 #include "solve/fem_force_field_cl.h"
 #include "solve/force_field.h"
 #include "solve/solve_on_device.h"
+#include "solve/solver.h"
 #include "suite/bench_cases.h"
 #include "validate/validate.h"
 
@@ -101,6 +102,11 @@ json real_ct_row(BenchCase& c, int cube_voxels, SolverMethod method, double limi
     row["wall_s"] = seconds_since(t0);
     row["converged"] = false;
     row["stop_reason"] = "time limit of the benchmark (" + std::to_string(int(limit_s)) + " s)";
+  } catch (const DivergedError& e) {
+    // A row, not the end of the benchmark: which solver fails on which model is what this table is for.
+    row["wall_s"] = seconds_since(t0);
+    row["converged"] = false;
+    row["stop_reason"] = std::string("diverged: ") + e.what();
   }
   return row;
 }
@@ -199,41 +205,36 @@ json measure_throughput(BenchContext& ctx) {
                                    "reaches, not a ratio"}}}};
 }
 
-// The rule: for each preset's cube size, among the models whose real-CT solve converged without inverted
-// tetrahedra, preview takes the fastest; balanced the fastest whose Lamé error (inner and outer, the finest cube
-// measured) is within 5 %; accurate the one with the smallest such error. The error is the model's at the ν
-// its scene uses (0.45 for the elements, 1/4 for the springs).
-json choose(const json& lame, const json& real_ct) {
-  auto lame_error = [&](const std::string& model) {
-    double best_cube = std::numeric_limits<double>::infinity(), err = std::numeric_limits<double>::infinity();
-    for (const auto& r : lame)
-      if (r["model"] == model && r["device"] == "cpu" &&
-          (model == "msd" || std::abs(r["poisson_ratio"].get<double>() - 0.45) < 1e-9) &&
-          r["cube_mm"].get<double>() < best_cube) {
-        best_cube = r["cube_mm"];
-        err = std::max(std::abs(r["rel_error_inner"].get<double>()), std::abs(r["rel_error_outer"].get<double>()));
-      }
-    return err;
-  };
+// The rule: the material model is the scene's physics, chosen by the user from the Lamé and real-CT tables; a preset
+// sets the cube size and, for each model, the solver. For each preset's cube size and each model, the benchmark's
+// pick is the fastest solver whose real-CT solve converged with 0 inverted tetrahedra; "follows" says whether the
+// preset's solver for that model (scene_presets.h) is that pick.
+json choose(const json& real_ct) {
   json out = json::array();
-  for (const char* preset : {"preview", "balanced", "accurate"}) {
-    const json* pick = nullptr;
-    double pick_key = std::numeric_limits<double>::infinity();
-    for (const auto& r : real_ct) {
-      if (r["preset"] != preset || !r["converged"].get<bool>() || r["inverted_tetrahedra"].get<int64_t>() != 0) continue;
-      const double err = lame_error(r["model"]), t = r["wall_s"];
-      const std::string p = preset;
-      const double key = p == "preview" ? t : p == "balanced" ? (err <= 0.05 ? t : INFINITY) : err + 1e-6 * t;
-      if (key < pick_key) { pick_key = key; pick = &r; }
+  for (const ScenePreset sp : {ScenePreset::Preview, ScenePreset::Balanced, ScenePreset::Accurate}) {
+    const std::string preset = enum_name(sp);
+    json per_model = json::array();
+    for (const MaterialModel model : {MaterialModel::Msd, MaterialModel::FemNeoHookean}) {
+      const std::string name = enum_name(model);
+      const json* pick = nullptr;
+      for (const auto& r : real_ct) {
+        if (r["preset"] != preset || r["model"] != name || !r["converged"].get<bool>() ||
+            r["inverted_tetrahedra"].get<int64_t>() != 0)
+          continue;
+        if (!pick || r["wall_s"].get<double>() < (*pick)["wall_s"].get<double>()) pick = &r;
+      }
+      const std::string preset_solver = enum_name(preset_method(preset_settings(sp), model));
+      json m = {{"model", name}, {"preset_solver", preset_solver}};
+      if (pick) {
+        m["fastest"] = {{"solver", (*pick)["solver"]}, {"wall_s", (*pick)["wall_s"]}};
+        m["follows"] = (*pick)["solver"] == preset_solver;
+      } else {
+        m["fastest"] = nullptr;
+        m["follows"] = nullptr;
+      }
+      per_model.push_back(m);
     }
-    const ScenePreset sp = std::string(preset) == "preview" ? ScenePreset::Preview
-                           : std::string(preset) == "balanced" ? ScenePreset::Balanced : ScenePreset::Accurate;
-    json j = {{"preset", preset}, {"preset_solver", enum_name(preset_settings(sp).method)},
-              {"preset_model", "msd (the scene's material.model: presets set the solver and cube only)"}};
-    j["chosen"] = pick ? json{{"model", (*pick)["model"]}, {"solver", (*pick)["solver"]}, {"wall_s", (*pick)["wall_s"]},
-                              {"lame_error", lame_error((*pick)["model"])}}
-                       : json(nullptr);
-    out.push_back(j);
+    out.push_back({{"preset", preset}, {"models", per_model}});
   }
   return out;
 }
@@ -246,10 +247,9 @@ json measure_material_models(BenchContext& ctx, const std::string& springs_scene
   out["real_ct"] = measure_real_ct(ctx, springs_scene, fem_scene);
   out["throughput"] = measure_throughput(ctx);
   out["choice_rule"] =
-      "per preset cube size, among models whose real-CT solve converged with 0 inverted tetrahedra: preview the "
-      "fastest; balanced the fastest whose Lame error (max of inner and outer, finest cube measured, the scene's nu) "
-      "is within 5 %; accurate the smallest such error";
-  out["choice"] = choose(out["lame"], out["real_ct"]);
+      "the model is the scene's physics; per preset cube size and model, the fastest solver whose real-CT solve "
+      "converged with 0 inverted tetrahedra, and whether the preset's solver for that model is it";
+  out["choice"] = choose(out["real_ct"]);
   return out;
 }
 
