@@ -108,8 +108,7 @@ Run add_validate(CLI::App& app) {
                     r.young_ratio_axis, 100.0 * (r.young_ratio_axis / r.expected_axis - 1.0), r.cubes_across);
       return 0;
     }
-    for (std::size_t i = 0; i < EnumNames<MaterialModel>::names.size(); ++i)
-      if (o->lame_model == EnumNames<MaterialModel>::names[i]) o->lame.model = MaterialModel(i);
+    if (const auto model = enum_from_name<MaterialModel>(o->lame_model)) o->lame.model = *model;
     o->lame.mean_dilatation = !o->per_tetrahedron;
     if (o->lame.model == MaterialModel::Msd && o->lame.poisson != 0.25)
       throw InputError("validate lame-sphere: --poisson applies to the FEM models; the springs' ν is 1/4");

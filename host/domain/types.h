@@ -5,6 +5,8 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <string_view>
 
 namespace pneumo {
 
@@ -82,5 +84,12 @@ template <class E> const char* enum_name(E e) {
   return EnumNames<E>::names[static_cast<std::size_t>(e)];
 }
 inline const char* role_name(Role r) { return enum_name(r); }
+
+/// The enum value a scene file's name spells, or nothing when it spells none.
+template <class E> std::optional<E> enum_from_name(std::string_view name) {
+  for (std::size_t i = 0; i < EnumNames<E>::names.size(); ++i)
+    if (name == EnumNames<E>::names[i]) return static_cast<E>(i);
+  return std::nullopt;
+}
 
 }  // namespace pneumo

@@ -177,8 +177,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& origin_path) {
     MaterialModel model = MaterialModel::Msd;
     if (const auto m = j.find("material"); m != j.end() && m->is_object())
       if (const auto name = m->find("model"); name != m->end() && name->is_string())
-        for (std::size_t i = 0; i < EnumNames<MaterialModel>::names.size(); ++i)
-          if (*name == EnumNames<MaterialModel>::names[i]) model = MaterialModel(i);
+        model = enum_from_name<MaterialModel>(name->get<std::string>()).value_or(MaterialModel::Msd);
     merged = preset_patch(*p, model);
     merged.merge_patch(j);
   }

@@ -53,10 +53,7 @@ std::optional<ScenePreset> find_preset(const nlohmann::json& scene) {
   if (!scene.is_object()) return std::nullopt;
   const auto it = scene.find("preset");
   if (it == scene.end() || !it->is_string()) return std::nullopt;
-  const auto& names = EnumNames<ScenePreset>::names;
-  for (std::size_t i = 0; i < names.size(); ++i)
-    if (*it == names[i]) return static_cast<ScenePreset>(i);
-  return std::nullopt;
+  return enum_from_name<ScenePreset>(it->get<std::string>());
 }
 
 const std::string& preset_reference_text() {
