@@ -106,20 +106,27 @@ void assign_the_shell(std::vector<Role>& role, const std::vector<uint8_t>& body,
   }
 }
 
+/// Undecided voxels of column (slice s, lateral l) anterior to anteriority `from(s, l)` → wall; a
+/// column whose `from` is negative is left alone. Rules 5b and 6b differ only in `from`.
+template <class From>
+void wall_anterior_of(std::vector<Role>& role, const SliceFrame& f, const From& from) {
+#pragma omp parallel for schedule(static)
+  for (int64_t s = 0; s < f.n_si; ++s)
+    for (int64_t l = 0; l < f.n_lat; ++l) {
+      const int64_t first = from(s, l);
+      if (first < 0) continue;
+      for (int64_t a = first + 1; a < f.n_ap; ++a) {
+        const int64_t v = f.index(l, f.ant(a), s);
+        if (role[v] == kUndecided) role[v] = Role::Wall;
+      }
+    }
+}
+
 /// Rule 5b: undecided voxels anterior to a prevesical label in the same axial column → wall.
 void attach_prevesical_space(std::vector<Role>& role, const uint16_t* label, const SliceFrame& f, const RoleRules& r) {
   if (!label || r.auto_prevesical_labels.empty()) return;
   const std::vector<int64_t> fronts = front_of_labels(label, f, LabelSet(r.auto_prevesical_labels));
-#pragma omp parallel for schedule(static)
-  for (int64_t s = 0; s < f.n_si; ++s)
-    for (int64_t l = 0; l < f.n_lat; ++l) {
-      const int64_t front = fronts[std::size_t(s * f.n_lat + l)];
-      if (front < 0) continue;
-      for (int64_t a = 0; a < f.n_ap; ++a) {
-        const int64_t v = f.index(l, a, s);
-        if (f.ant(a) > front && role[v] == kUndecided) role[v] = Role::Wall;
-      }
-    }
+  wall_anterior_of(role, f, [&](int64_t s, int64_t l) { return fronts[std::size_t(s * f.n_lat + l)]; });
 }
 
 /// Rule 6b: below the peritoneal reflection at the dome of the prevesical labels, undecided voxels
@@ -148,15 +155,7 @@ void attach_below_the_reflection(std::vector<Role>& role, const uint16_t* label,
     if (back[s] >= 0) carried = back[s];
     else back[s] = carried;   // -1 above the dome
   }
-#pragma omp parallel for schedule(static)
-  for (int64_t s = 0; s < f.n_si; ++s) {
-    if (back[s] < 0) continue;
-    for (int64_t a = back[s] + 1; a < f.n_ap; ++a)
-      for (int64_t l = 0; l < f.n_lat; ++l) {
-        const int64_t v = f.index(l, f.ant(a), s);
-        if (role[v] == kUndecided) role[v] = Role::Wall;
-      }
-  }
+  wall_anterior_of(role, f, [&](int64_t s, int64_t) { return back[std::size_t(s)]; });
 }
 
 /// Rule 6: undecided voxels lateral to bone (away from the midline) → fixed.
