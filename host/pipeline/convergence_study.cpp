@@ -5,7 +5,6 @@
 
 #include "core/error.h"
 #include "core/log.h"
-#include "pipeline/cavity_measures.h"
 #include "pipeline/simulate.h"
 #include "solve/forces.h"
 
@@ -61,7 +60,7 @@ ConvergenceStudy convergence_study(const Scene& scene, const std::vector<int>& c
     r.anterior_rise_mm = d.anterior_rise_mm;
     r.cavity_volume_ml = d.cavity_volume_ml;
     r.mean_wall_displacement_mm = d.mean_wall_displacement_mm;
-    r.viscera_posterior_motion_mm = mean_posterior_motion_of_anterior_viscera_mm(sim.mesh, sim.result.x);
+    r.viscera_posterior_motion_mm = d.anterior_viscera_posterior_motion_mm;
     r.nodes = sim.mesh.node_count();
     r.inverted = count_inverted(sim.mesh, sim.result.x);
     r.steps = sim.result.steps;

@@ -177,6 +177,7 @@ DeformationMetrics deformation_metrics(const Mesh& m, const std::vector<Vec3>& x
     d.mean_viscera_displacement_mm /= double(viscera);
     d.mean_viscera_anterior_mm /= double(viscera);
   }
+  d.anterior_viscera_posterior_motion_mm = mean_posterior_motion_of_anterior_viscera_mm(m, x);
   for (int64_t t = 0; t < int64_t(m.tets.size()); ++t) {
     if (m.tet_part[t] != Part::Viscera) continue;
     const auto& q = m.tets[t];
@@ -233,7 +234,7 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   j["anterior_rise_mm"] = d.anterior_rise_mm;
   j["mean_viscera_displacement_mm"] = d.mean_viscera_displacement_mm;
   j["mean_viscera_anterior_displacement_mm"] = d.mean_viscera_anterior_mm;
-  j["anterior_viscera_posterior_motion_mm"] = mean_posterior_motion_of_anterior_viscera_mm(sim.mesh, r.x);
+  j["anterior_viscera_posterior_motion_mm"] = d.anterior_viscera_posterior_motion_mm;
   j["max_fixed_displacement_mm"] = d.max_fixed_displacement_mm;
   j["cavity_volume_ml"] = d.cavity_volume_ml;
   j["viscera_volume_change_ml"] = d.viscera_volume_change_ml;

@@ -71,6 +71,7 @@ void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hoo
 struct DeformationMetrics {
   double max_wall_displacement_mm = 0, mean_wall_displacement_mm = 0, anterior_rise_mm = 0;
   double mean_viscera_displacement_mm = 0, mean_viscera_anterior_mm = 0;
+  double anterior_viscera_posterior_motion_mm = 0;   // over the viscera's anterior half (cavity_measures.h)
   double cavity_volume_ml = 0;
   /// Change of the viscera's tissue volume, Σ fraction × (V − V_rest) over their tetrahedra: what
   /// they give up to the gas (negative when compressed). Nearly incompressible viscera keep it near 0.
