@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 
 #include "pipeline/simulate.h"
 #include "scene/scene_presets.h"
