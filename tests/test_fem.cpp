@@ -475,35 +475,33 @@ TEST(ImplicitEuler, SettlesAtNewtonsEquilibriumWithStepsFarBeyondTheExplicitBoun
 }
 
 TEST(FemLame, HollowSphereMatchesLamesClosedFormAndConverges) {
-  // Compared: the surface-mean radial displacement of Lamé's sphere (a = 50, b = 100 mm, E = 60 kPa,
-  // ν = 0.45, nearly incompressible) against the closed form with the nominal moduli, at 10 and 5 mm
-  // cubes, one placement, for both FEM laws with the cube-averaged dilatation. Tolerances at 5 mm:
-  // inner 3 %, the issue's; outer 4 %, where the issue asks 3 % and the neo-Hookean law does not yet
-  // reach it (measured, this placement: co-rotational +0.7 / +3.1 %, neo-Hookean +0.9 / +3.6 % inner /
-  // outer; the staircase of the outer surface voxelised at the cube size dominates, docs/fem.md).
-  // The outer error must also fall from 10 to 5 mm (3.4 → 3.1 %, 4.4 → 3.6 %): convergence, slower
-  // than first order (observed order about 0.6–0.7 down to 2.5 mm).
+  // Compared: the mean radial displacement on the true spheres r = a and r = b of Lamé's sphere (a = 50,
+  // b = 100 mm, E = 60 kPa, voxels a quarter of the cube, the mesh's field evaluated there) against the
+  // closed form with the nominal moduli, at 10 and 5 mm cubes, one placement, for both FEM laws with
+  // the cube-averaged dilatation, at ν = 0.25 and 0.45. Tolerances, the issue's: within 3 % at 5 mm,
+  // and converging at first order or better, i.e. the error at 5 mm at most half that at 10 mm
+  // (measured, four placements: −2.4/−1.5 → −0.6/−0.4 % at ν 0.25, −3.5/−3.2 → −0.9/−0.8 % at 0.45,
+  // inner/outer, co-rotational; an observed order of about 2, as linear elements' displacements converge).
   Progress::set_enabled(false);
-  for (MaterialModel model : {MaterialModel::FemCorotational, MaterialModel::FemNeoHookean}) {
-    SCOPED_TRACE(enum_name(model));
-    double previous_outer = INFINITY;
-    for (double cube : {10.0, 5.0}) {
-      LameOptions o;
-      o.model = model;
-      o.poisson = 0.45;
-      o.cube_mm = cube;
-      o.placements = 1;
-      const LameResult r = validate_lame_sphere(o);
-      std::printf("%s cube %.0f mm: inner %+.2f %%, outer %+.2f %%\n", enum_name(model), cube, 100 * r.rel_error_inner,
-                  100 * r.rel_error_outer);
-      if (cube == 5.0) {
-        EXPECT_LE(std::abs(r.rel_error_inner), 0.03);
-        EXPECT_LE(std::abs(r.rel_error_outer), 0.04);
-        EXPECT_LT(std::abs(r.rel_error_outer), previous_outer);
+  for (MaterialModel model : {MaterialModel::FemCorotational, MaterialModel::FemNeoHookean})
+    for (double nu : {0.25, 0.45}) {
+      SCOPED_TRACE(std::string(enum_name(model)) + " nu " + std::to_string(nu));
+      LameResult at[2];
+      for (int i = 0; i < 2; ++i) {
+        LameOptions o;
+        o.model = model;
+        o.poisson = nu;
+        o.cube_mm = i == 0 ? 10.0 : 5.0;
+        o.placements = 1;
+        at[i] = validate_lame_sphere(o);
+        std::printf("%s nu %.2f, cube %.0f mm: inner %+.2f %%, outer %+.2f %%\n", enum_name(model), nu, o.cube_mm,
+                    100 * at[i].rel_error_inner, 100 * at[i].rel_error_outer);
       }
-      previous_outer = std::abs(r.rel_error_outer);
+      EXPECT_LE(std::abs(at[1].rel_error_inner), 0.03);
+      EXPECT_LE(std::abs(at[1].rel_error_outer), 0.03);
+      EXPECT_LE(std::abs(at[1].rel_error_inner), 0.5 * std::abs(at[0].rel_error_inner));
+      EXPECT_LE(std::abs(at[1].rel_error_outer), 0.5 * std::abs(at[0].rel_error_outer));
     }
-  }
 }
 
 TEST(FemLame, EveryDeviceGivesTheCpusSphere) {

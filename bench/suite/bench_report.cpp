@@ -164,8 +164,9 @@ void stability(std::ostringstream& md, const json& st) {
 }
 
 void material_models(std::ostringstream& md, const json& mm) {
-  md << "## Material models\n\nLamé's hollow sphere (a = 50, b = 100 mm, E = 60 kPa, 10 mmHg, one placement): the "
-        "error of the surface-mean displacement against the closed form with the nominal moduli.\n\n";
+  md << "## Material models\n\nLamé's hollow sphere (a = 50, b = 100 mm, E = 60 kPa, 10 mmHg, one placement, voxels a "
+        "quarter of the cube): the error of the mean displacement on the true spheres against the closed form with "
+        "the nominal moduli.\n\n";
   md << "| model | ν | cube | device | inner | outer | iterations | s |\n|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : mm["lame"])
     md << "| " << r["model"].get<std::string>() << " | " << num(r["poisson_ratio"], "%.2f") << " | "

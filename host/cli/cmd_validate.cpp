@@ -35,7 +35,7 @@ Run add_validate(CLI::App& app) {
   lame->add_option("--poisson", o->lame.poisson, "Poisson's ratio of the finite elements (the springs' is 1/4)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.49));
-  lame->add_option("--voxel-mm", o->lame.voxel_mm, "Voxel size of the sphere's image (0: one voxel per cube)")
+  lame->add_option("--voxel-mm", o->lame.voxel_mm, "Voxel size of the sphere's image (0: a quarter of the cube; the cube size itself: a staircase of whole cubes)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 50.0));
   lame->add_flag("--per-tetrahedron", o->per_tetrahedron,
@@ -115,11 +115,13 @@ Run add_validate(CLI::App& app) {
     const LameResult r = validate_lame_sphere(o->lame);
     if (o->json) std::cout << to_json(r).dump(2) << "\n";
     else {
-      std::printf("Lamé sphere a = %g mm, b = %g mm, E = %g kPa, nu = %g, %s, %g mmHg, cubes %g mm, %d placements "
+      std::printf("Lamé sphere a = %g mm, b = %g mm, E = %g kPa, nu = %g, %s, %g mmHg, cubes %g mm, voxels %g mm, %d placements "
                   "(%lld nodes each, %.1f s)\n",
                   o->lame.inner_mm, o->lame.outer_mm, o->lame.young_kpa,
                   o->lame.model == MaterialModel::Msd ? 0.25 : o->lame.poisson, o->lame_model.c_str(),
-                  o->lame.pressure_mmhg, o->lame.cube_mm, o->lame.placements, (long long)r.nodes, r.wall_time_s);
+                  o->lame.pressure_mmhg, o->lame.cube_mm, lame_voxel_mm(o->lame), o->lame.placements, (long long)r.nodes,
+                  r.wall_time_s);
+      std::printf("  on the true spheres r = a and r = b (the mesh's field there):\n");
       std::printf("  inner: %.4f mm, nominal %.4f (%+.1f %%), model's moduli %.4f (%+.1f %%)\n", r.u_inner_mm,
                   r.u_inner_analytic_mm, 100 * r.rel_error_inner, r.u_inner_lattice_mm, 100 * r.rel_error_inner_lattice);
       std::printf("         placements %.4f … %.4f mm; plain node mean %.4f mm\n", r.u_inner_min_mm, r.u_inner_max_mm,
@@ -128,6 +130,8 @@ Run add_validate(CLI::App& app) {
                   r.u_outer_analytic_mm, 100 * r.rel_error_outer, r.u_outer_lattice_mm, 100 * r.rel_error_outer_lattice);
       std::printf("         placements %.4f … %.4f mm; plain node mean %.4f mm\n", r.u_outer_min_mm, r.u_outer_max_mm,
                   r.u_outer_node_mean_mm);
+      std::printf("  over the mesh's boundary (nodes up to a cube from the spheres): inner %.4f mm, outer %.4f mm\n",
+                  r.u_inner_boundary_mm, r.u_outer_boundary_mm);
     }
     return 0;
   };

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <stdexcept>
+#include <unordered_map>
 
 
 #include "core/units.h"
@@ -14,6 +16,8 @@ namespace pneumo {
 double lame_sphere_u(double r, double a, double b, double p, double bulk, double shear) {
   return p * a * a * a / (b * b * b - a * a * a) * (r / (3.0 * bulk) + b * b * b / (4.0 * shear * r * r));
 }
+
+double lame_voxel_mm(const LameOptions& o) { return o.voxel_mm > 0.0 ? o.voxel_mm : 0.25 * o.cube_mm; }
 
 Vec3 lame_placement(int k) {
   // Roberts' R3 low-discrepancy sequence: placements spread evenly over the cube, none on a symmetry
@@ -27,17 +31,97 @@ Vec3 lame_placement(int k) {
 
 namespace {
 
+constexpr int kSpherePoints = 8192;
+
 struct PlacementMeans {
-  double inner_area = 0, outer_area = 0;   // surface means (mm)
+  double inner_sphere = 0, outer_sphere = 0;   // means over the true spheres r = a, r = b (mm)
+  double inner_area = 0, outer_area = 0;   // means over the mesh's boundary (mm)
   double inner_node = 0, outer_node = 0;   // plain node means (mm)
+  double inner_outside = 0, outer_outside = 0;   // share of the sphere's points outside the mesh
   int64_t nodes = 0, inner_nodes = 0, outer_nodes = 0, steps = 0;
   double residual = 0;
 };
 
+// The piecewise-linear field of the tetrahedra at points of the rest frame. A point is carried by the
+// tetrahedron of its lattice cube that holds it (largest smallest barycentric weight); a point in no
+// meshed cube (the staircase lies inside the true surface there) by the tetrahedron of the nearest
+// meshed cube whose weights are least negative: a linear extrapolation over at most a cube.
+class TetField {
+ public:
+  TetField(const Mesh& m, double cube_m) : m_(m), cube_m_(cube_m) {
+    origin_ = m.rest_m[0] - Vec3(m.node_lattice[0][0], m.node_lattice[0][1], m.node_lattice[0][2]) * cube_m;
+    for (std::size_t t = 0; t < m.tets.size(); ++t) {
+      Vec3 c = Vec3::Zero();
+      for (int32_t n : m.tets[t]) c += 0.25 * m.rest_m[n];
+      by_cube_[key(cell(c))].push_back(int32_t(t));
+    }
+  }
+
+  /// The field's value at rest point p (metres) from the node values `u`; `outside` tells whether no
+  /// meshed cube held p.
+  Vec3 at(const Vec3& p, const std::vector<Vec3>& u, bool& outside) const {
+    const std::array<int64_t, 3> c = cell(p);
+    int32_t best = -1;
+    std::array<double, 4> best_w{};
+    double best_min = -HUGE_VAL;
+    auto consider = [&](const std::array<int64_t, 3>& q) {
+      const auto it = by_cube_.find(key(q));
+      if (it == by_cube_.end()) return;
+      for (int32_t t : it->second) {
+        const std::array<double, 4> w = weights(t, p);
+        const double lo = *std::min_element(w.begin(), w.end());
+        if (lo > best_min) { best_min = lo; best = t; best_w = w; }
+      }
+    };
+    consider(c);
+    outside = best < 0;
+    for (int dz = -1; dz <= 1 && best < 0; ++dz)   // then the 26 neighbours together
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          if (dx || dy || dz) consider({c[0] + dx, c[1] + dy, c[2] + dz});
+    if (best < 0) throw std::logic_error("validate_lame_sphere: a point on the sphere is more than a cube from the mesh");
+    Vec3 v = Vec3::Zero();
+    for (int i = 0; i < 4; ++i) v += best_w[i] * u[m_.tets[best][i]];
+    return v;
+  }
+
+ private:
+  std::array<int64_t, 3> cell(const Vec3& p) const {
+    const Vec3 q = (p - origin_) / cube_m_;
+    return {int64_t(std::floor(q[0])), int64_t(std::floor(q[1])), int64_t(std::floor(q[2]))};
+  }
+  static int64_t key(const std::array<int64_t, 3>& c) {
+    return ((c[2] + (1 << 20)) << 42) | ((c[1] + (1 << 20)) << 21) | (c[0] + (1 << 20));
+  }
+  std::array<double, 4> weights(int32_t t, const Vec3& p) const {
+    const auto& q = m_.tets[t];
+    Mat3 D;
+    for (int i = 0; i < 3; ++i) D.col(i) = m_.rest_m[q[i + 1]] - m_.rest_m[q[0]];
+    const Vec3 l = D.inverse() * (p - m_.rest_m[q[0]]);
+    return {1.0 - l.sum(), l[0], l[1], l[2]};
+  }
+  const Mesh& m_;
+  double cube_m_;
+  Vec3 origin_;
+  std::unordered_map<int64_t, std::vector<int32_t>> by_cube_;
+};
+
+/// n points spread evenly over the unit sphere (the Fibonacci lattice), each standing for 1/n of its area.
+std::vector<Vec3> fibonacci_sphere(int n) {
+  std::vector<Vec3> d(n);
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / n, r = std::sqrt(1.0 - z * z);
+    d[i] = Vec3(r * std::cos(golden * i), r * std::sin(golden * i), z);
+  }
+  return d;
+}
+
 PlacementMeans solve_placement(const LameOptions& o, const Vec3& offset_cubes) {
   // The sphere is voxelised at voxel_mm (each voxel by its centre) and meshed with cubes of cube_mm,
-  // exactly as the pipeline meshes a CT: a cube holding any shell voxel is a wall cube.
-  const double v = o.voxel_mm > 0.0 ? o.voxel_mm : o.cube_mm;
+  // exactly as the pipeline meshes a CT: a cube holding any shell voxel is a wall cube, its
+  // tetrahedra weighted by the shell's share of their volume.
+  const double v = lame_voxel_mm(o);
   const int L = int(std::lround(o.cube_mm / v));
   if (L < 1 || std::abs(L * v - o.cube_mm) > 1e-9 * o.cube_mm)
     throw std::invalid_argument("validate_lame_sphere: cube_mm must be a whole multiple of voxel_mm");
@@ -109,6 +193,26 @@ PlacementMeans solve_placement(const LameOptions& o, const Vec3& offset_cubes) {
       sum_n[s] += u_mm;
       ++count[s];
     }
+  // The closed form describes the true spheres: the field there, radial component, mean over the
+  // lattice's points (the finite cell method's boundary lies inside the cut cubes, not at their nodes).
+  {
+    std::vector<Vec3> u(m.node_count());
+    for (int64_t i = 0; i < m.node_count(); ++i) u[i] = r.x[i] - m.rest_m[i];
+    const TetField field(m, units::mm_to_m(o.cube_mm));
+    const std::vector<Vec3> dirs = fibonacci_sphere(kSpherePoints);
+    for (int s = 0; s < 2; ++s) {
+      const double radius_m = units::mm_to_m(s == 0 ? o.inner_mm : o.outer_mm);
+      double sum = 0.0;
+      int outside = 0;
+      for (const Vec3& d : dirs) {
+        bool out_of_mesh = false;
+        sum += field.at(radius_m * d, u, out_of_mesh).dot(d);
+        outside += out_of_mesh;
+      }
+      (s == 0 ? out.inner_sphere : out.outer_sphere) = units::m_to_mm(sum / dirs.size()) / o.solve_fraction;
+      (s == 0 ? out.inner_outside : out.outer_outside) = double(outside) / dirs.size();
+    }
+  }
   out.inner_area = sum_a[0] / std::max(w_a[0], 1e-300);
   out.outer_area = sum_a[1] / std::max(w_a[1], 1e-300);
   out.inner_node = sum_n[0] / std::max<int64_t>(count[0], 1);
@@ -132,14 +236,18 @@ LameResult validate_lame_sphere(const LameOptions& o) {
   out.u_inner_max_mm = out.u_outer_max_mm = -HUGE_VAL;
   for (int k = 0; k < o.placements; ++k) {
     const PlacementMeans p = solve_placement(o, lame_placement(k));
-    out.u_inner_mm += p.inner_area / o.placements;
-    out.u_outer_mm += p.outer_area / o.placements;
+    out.u_inner_mm += p.inner_sphere / o.placements;
+    out.u_outer_mm += p.outer_sphere / o.placements;
+    out.u_inner_boundary_mm += p.inner_area / o.placements;
+    out.u_outer_boundary_mm += p.outer_area / o.placements;
+    out.inner_points_outside += p.inner_outside / o.placements;
+    out.outer_points_outside += p.outer_outside / o.placements;
     out.u_inner_node_mean_mm += p.inner_node / o.placements;
     out.u_outer_node_mean_mm += p.outer_node / o.placements;
-    out.u_inner_min_mm = std::min(out.u_inner_min_mm, p.inner_area);
-    out.u_inner_max_mm = std::max(out.u_inner_max_mm, p.inner_area);
-    out.u_outer_min_mm = std::min(out.u_outer_min_mm, p.outer_area);
-    out.u_outer_max_mm = std::max(out.u_outer_max_mm, p.outer_area);
+    out.u_inner_min_mm = std::min(out.u_inner_min_mm, p.inner_sphere);
+    out.u_inner_max_mm = std::max(out.u_inner_max_mm, p.inner_sphere);
+    out.u_outer_min_mm = std::min(out.u_outer_min_mm, p.outer_sphere);
+    out.u_outer_max_mm = std::max(out.u_outer_max_mm, p.outer_sphere);
     out.nodes = std::max(out.nodes, p.nodes);
     out.inner_nodes = std::max(out.inner_nodes, p.inner_nodes);
     out.outer_nodes = std::max(out.outer_nodes, p.outer_nodes);
@@ -173,7 +281,7 @@ nlohmann::json to_json(const LameResult& r) {
           {"poisson_ratio", r.options.model == MaterialModel::Msd ? 0.25 : r.options.poisson},
           {"mean_dilatation", r.options.mean_dilatation},
           {"cube_mm", r.options.cube_mm},
-          {"voxel_mm", r.options.voxel_mm > 0 ? r.options.voxel_mm : r.options.cube_mm},
+          {"voxel_mm", lame_voxel_mm(r.options)},
           {"inner_radius_mm", r.options.inner_mm},
           {"outer_radius_mm", r.options.outer_mm},
           {"young_kpa", r.options.young_kpa},
@@ -192,6 +300,10 @@ nlohmann::json to_json(const LameResult& r) {
           {"u_outer_lattice_mm", r.u_outer_lattice_mm},
           {"rel_error_inner_lattice", r.rel_error_inner_lattice},
           {"rel_error_outer_lattice", r.rel_error_outer_lattice},
+          {"u_inner_boundary_mm", r.u_inner_boundary_mm},
+          {"u_outer_boundary_mm", r.u_outer_boundary_mm},
+          {"inner_points_outside_mesh", r.inner_points_outside},
+          {"outer_points_outside_mesh", r.outer_points_outside},
           {"u_inner_range_mm", {r.u_inner_min_mm, r.u_inner_max_mm}},
           {"u_outer_range_mm", {r.u_outer_min_mm, r.u_outer_max_mm}},
           {"u_inner_node_mean_mm", r.u_inner_node_mean_mm},
