@@ -157,4 +157,5 @@ TEST(Cli, ValidateJsonHasTheDocumentedKeys) {
               j.at("rel_error_inner").get<double>(), 1e-12);
 
   EXPECT_EQ(run_pneumo("validate lame-sphere --placements 0").code, 2);
+  EXPECT_EQ(run_pneumo("validate lame-sphere --cube-mm 10 --voxel-mm 3").code, 2);   // not a whole multiple
 }

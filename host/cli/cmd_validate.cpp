@@ -38,6 +38,10 @@ Run add_validate(CLI::App& app) {
   lame->add_option("--voxel-mm", o->lame.voxel_mm, "Voxel size of the sphere's image (0: a quarter of the cube; the cube size itself: a staircase of whole cubes)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 50.0));
+  lame->add_option("--pressure-mmhg", o->lame.pressure_mmhg,
+                   "Internal pressure; solved at a hundredth of it and scaled back, since the closed form is linear")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 60.0));
   lame->add_flag("--per-tetrahedron", o->per_tetrahedron,
                  "FEM: the dilatation per tetrahedron instead of averaged per cube (shows volumetric locking)");
   lame->add_option("--device", o->lame.device, "cpu, opencl or opencl:P:D (the FEM models solve there; the springs' static solver too)")

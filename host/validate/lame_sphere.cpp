@@ -2,11 +2,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <stdexcept>
 #include <unordered_map>
 
 
+#include "core/error.h"
 #include "core/units.h"
 #include "solve/solve_on_device.h"
 #include "validate/validate.h"
@@ -123,8 +125,12 @@ PlacementMeans solve_placement(const LameOptions& o, const Vec3& offset_cubes) {
   // tetrahedra weighted by the shell's share of their volume.
   const double v = lame_voxel_mm(o);
   const int L = int(std::lround(o.cube_mm / v));
-  if (L < 1 || std::abs(L * v - o.cube_mm) > 1e-9 * o.cube_mm)
-    throw std::invalid_argument("validate_lame_sphere: cube_mm must be a whole multiple of voxel_mm");
+  if (L < 1 || std::abs(L * v - o.cube_mm) > 1e-9 * o.cube_mm) {
+    char what[160];
+    std::snprintf(what, sizeof what, "validate lame-sphere: --cube-mm (%g) must be a whole multiple of --voxel-mm (%g)",
+                  o.cube_mm, v);
+    throw InputError(what);
+  }
   const int64_t half = (int64_t(std::ceil(o.outer_mm / o.cube_mm)) + 1) * L;
   Geometry g;
   g.dims = {2 * half, 2 * half, 2 * half};
