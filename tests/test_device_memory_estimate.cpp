@@ -20,6 +20,8 @@
 #include "pipeline/warp_stage.h"
 #include "scene/scene.h"
 #include "solve/fem_force_field_cl.h"
+#include "solve/interface_tie.h"
+#include "solve/newton_cl.h"
 #include "solve/solver_cl.h"
 #include "tiny_case_support.h"
 #include "warp/warp.h"
@@ -112,6 +114,34 @@ TEST_P(DeviceMemoryEstimate, TheFiniteElementsAllocateNoMoreThanTheirEstimate) {
   });
   std::printf("finite elements: %llu bytes allocated, %llu estimated\n", (unsigned long long)allocated,
               (unsigned long long)estimate);
+  EXPECT_GT(allocated, 0u);
+  EXPECT_LE(allocated, estimate);
+  EXPECT_LT(estimate, 2 * allocated) << "the estimate would refuse meshes that fit";
+}
+
+TEST_P(DeviceMemoryEstimate, NewtonsDeviceSolveAllocatesNoMoreThanItsEstimate) {
+  // Newton's linear solve on the device (newton_cl.h) with every pair of the interface bonded: what its
+  // construction, a linearisation and a solve create, against newton_linear_solver_cl_bytes; and the
+  // estimate within twice of it. The field's own buffers are counted by the test above.
+  ForceModel model;
+  model.material = MaterialModel::FemNeoHookean;
+  model.pressure_pa = 1600.0;
+  model.tie_interface = true;
+  auto field = make_fem_force_field_cl(*ctx_, sim_.mesh, model.material);
+  const std::vector<TiedPair> ties = interface_pairs(sim_.mesh);
+  std::vector<Vec3> f;
+  field->evaluate(model, sim_.mesh.rest_m, {}, f);
+  const uint64_t allocated = allocated_by([&] {
+    auto solver = field->device_linear_solver(ties);
+    ASSERT_NE(solver, nullptr);
+    solver->linearize(model, sim_.mesh.rest_m);
+    Shift shift;
+    std::vector<Vec3> d;
+    solver->solve(f, 0.1, 20, shift, d);
+  });
+  const uint64_t estimate = newton_linear_solver_cl_bytes(sim_.mesh, ties.size());
+  std::printf("Newton's device solve: %llu bytes allocated, %llu estimated (%zu bonds)\n",
+              (unsigned long long)allocated, (unsigned long long)estimate, ties.size());
   EXPECT_GT(allocated, 0u);
   EXPECT_LE(allocated, estimate);
   EXPECT_LT(estimate, 2 * allocated) << "the estimate would refuse meshes that fit";

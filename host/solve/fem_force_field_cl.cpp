@@ -7,6 +7,7 @@
 #include "mesh/adjacency.h"
 #include "solve/fem_tets.h"
 #include "solve/forces_cl.h"
+#include "solve/newton_cl.h"
 
 namespace pneumo {
 
@@ -119,10 +120,23 @@ class ClFemForceField final : public ForceField {
   void linearize(const ForceModel& model, const std::vector<Vec3>& x) override { update_states(model, x); }
 
   void stiffness_product(const std::vector<Vec3>& p, std::vector<Vec3>& kp) override {
+    ctx_.queue().enqueueWriteBuffer(p_, CL_TRUE, 0, N_ * sizeof(cl_float4), to_float4(p).data());
+    product(p_, f_);
+    download(f_, kp);
+  }
+
+  std::unique_ptr<NewtonLinearSolver> device_linear_solver(const std::vector<TiedPair>& ties) override {
+    DeviceStiffness k;
+    k.field = this;
+    k.product = [this](const cl::Buffer& p, cl::Buffer& kp) { product(p, kp); };
+    return make_newton_linear_solver_cl(ctx_, m_, std::move(k), ties);
+  }
+
+  // kp = K p on device buffers, at the last linearisation.
+  void product(const cl::Buffer& p, cl::Buffer& kp) {
     auto& q = ctx_.queue();
-    q.enqueueWriteBuffer(p_, CL_TRUE, 0, N_ * sizeof(cl_float4), to_float4(p).data());
     if (T_ > 0) {
-      ocl::set_args(k_dF_, p_, tets_buf_, dm_inv_, state_, law_int(), cl_int(T_), dF_);
+      ocl::set_args(k_dF_, p, tets_buf_, dm_inv_, state_, law_int(), cl_int(T_), dF_);
       q.enqueueNDRangeKernel(k_dF_, cl::NullRange, cl::NDRange(global_size(T_)), cl::NDRange(kLocal));
       average(dF_, 10, 9, debar_);
       ocl::set_args(k_dforces_, state_, dm_inv_, consts_, group_of_tet_, ebar_, debar_, dF_, law_int(), float(b_),
@@ -130,9 +144,8 @@ class ClFemForceField final : public ForceField {
       q.enqueueNDRangeKernel(k_dforces_, cl::NullRange, cl::NDRange(global_size(T_)), cl::NDRange(kLocal));
     }
     ocl::set_args(k_gather_, tet_force_, tet_start_, tet_item_, load_force_, load_start_, load_item_, cl_int(0),
-                  mass_, cl_float4{{0, 0, 0, 0}}, cl_int(N_), f_);
+                  mass_, cl_float4{{0, 0, 0, 0}}, cl_int(N_), kp);
     q.enqueueNDRangeKernel(k_gather_, cl::NullRange, cl::NDRange(global_size(N_)), cl::NDRange(kLocal));
-    download(f_, kp);
   }
 
   void stiffness_diagonal(std::vector<Mat3>& blocks) override {

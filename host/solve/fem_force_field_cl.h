@@ -2,8 +2,9 @@
 // The finite elements of fem_force_field.cpp on an OpenCL device (kernels/fem_forces.cl), float32,
 // behind the same ForceField interface, so Newton (solve_newton.cpp) solves with it unchanged. The
 // mesh, the element states and the group averages stay on the device; each call moves one node
-// vector up (positions as displacements, or a direction) and one down (forces or K p), which the
-// conjugate gradients on the host then combine. Pressure loads use msd_forces.cl's load_pressure.
+// vector up (positions as displacements, or a direction) and one down (forces or K p). Newton's
+// linear solve runs on the device too (device_linear_solver, newton_cl.h), around the same product on
+// device buffers. Pressure loads use msd_forces.cl's load_pressure.
 #include <memory>
 
 #include "cl/cl_runtime.h"

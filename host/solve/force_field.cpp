@@ -5,6 +5,7 @@
 
 #include "solve/contact.h"
 #include "solve/interface_tie.h"
+#include "solve/newton_linear_solver.h"
 
 namespace pneumo {
 
@@ -18,6 +19,8 @@ std::unique_ptr<ForceField> make_material_field(const Mesh& m, const ForceModel&
   throw std::logic_error("unknown material model");
 }
 }  // namespace
+
+std::unique_ptr<NewtonLinearSolver> ForceField::device_linear_solver(const std::vector<TiedPair>&) { return nullptr; }
 
 std::unique_ptr<ForceField> make_force_field(const Mesh& m, const ForceModel& model) {
   return with_interface_tie(m, model, with_contact(m, model, make_material_field(m, model)));

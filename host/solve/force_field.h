@@ -18,6 +18,9 @@
 
 namespace pneumo {
 
+class NewtonLinearSolver;
+struct TiedPair;
+
 class ForceField {
  public:
   virtual ~ForceField() = default;
@@ -39,6 +42,11 @@ class ForceField {
   virtual std::vector<double> fire_masses(const ForceModel& model) = 0;
   /// Force evaluations so far (stiffness products not counted).
   virtual int64_t evaluations() const = 0;
+  /// Newton's whole linear solve where this field keeps its state (an OpenCL device: newton_cl.h),
+  /// with the pressure's stiffness and the bonds `ties` added to this field's K; nullptr where the
+  /// host solves it (newton_linear_solver.h). A field that wraps another adds its own terms or, where
+  /// the device cannot hold them (contact), answers nullptr.
+  virtual std::unique_ptr<NewtonLinearSolver> device_linear_solver(const std::vector<TiedPair>& ties);
 };
 
 /// The force field of `model.material` on mesh m, with the contact term when model.contact_stiffness > 0

@@ -4,6 +4,7 @@
 #include <tuple>
 
 #include "solve/force_field.h"
+#include "solve/newton_linear_solver.h"
 
 namespace pneumo {
 
@@ -62,6 +63,12 @@ class TiedForceField final : public ForceField {
   }
 
   int64_t evaluations() const override { return inner_->evaluations(); }
+
+  std::unique_ptr<NewtonLinearSolver> device_linear_solver(const std::vector<TiedPair>& ties) override {
+    std::vector<TiedPair> all = ties;
+    all.insert(all.end(), pairs_.begin(), pairs_.end());
+    return inner_->device_linear_solver(all);
+  }
 
  private:
   Vec3 stretch(const TiedPair& p, const std::vector<Vec3>& x) const {

@@ -23,6 +23,9 @@ class PressureStiffness {
   void linearize(const Mesh& m, const std::vector<Vec3>& x, double pressure_pa);
   /// kp += S p, S the symmetric part of K_p at the last linearisation.
   void add_product(const std::vector<Vec3>& p, std::vector<Vec3>& kp) const;
+  /// Per load, u_ij for the pairs (0,1), (0,2), (0,3), (1,2), (1,3), (2,3) of its tetrahedron's
+  /// vertices (empty at P = 0): what a device computes S p from (kernels/newton_cg.cl).
+  const std::vector<std::array<Vec3, 6>>& pairs() const { return u_; }
 
  private:
   const Mesh* m_ = nullptr;

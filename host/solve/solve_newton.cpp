@@ -1,7 +1,8 @@
 // Static equilibrium by Newton's method with matrix-free preconditioned conjugate gradients, on any
 // force field (force_field.h): the springs or the finite elements (issue "Bano's row").
 //
-// Each Newton iteration solves K d = f(x) for the step d, with K = −∂f/∂x the stiffness at x (the
+// Each Newton iteration solves K d = f(x) for the step d (newton_linear_solver.h: on the host, or on
+// the OpenCL device that holds the force field), with K = −∂f/∂x the stiffness at x (the
 // force field's elastic part and the gas pressure's, pressure_stiffness.h), by CG preconditioned with
 // the inverse 3×3 diagonal blocks of K (block Jacobi), to a relative residual η chosen as Eisenstat &
 // Walker (1996, choice 2: η = 0.9 (|f_k|/|f_{k−1}|)², within [10⁻³, 0.1]), so early iterations are
@@ -23,7 +24,7 @@
 
 #include "solve/conjugate_gradients.h"
 #include "solve/force_field.h"
-#include "solve/pressure_stiffness.h"
+#include "solve/newton_linear_solver.h"
 #include "solve/solver_common.h"
 
 namespace pneumo {
@@ -45,8 +46,7 @@ SolveResult solve_newton_on(const Mesh& m, const SolveOptions& opt, ForceField& 
   const std::string advice = detail::kLoadAdvice;
 
   std::vector<Vec3> f, trial(N), f_trial, d;
-  std::vector<Mat3> blocks;
-  PressureStiffness pressure;
+  const std::unique_ptr<NewtonLinearSolver> linear = newton_linear_solver(m, field);
   Shift shift;
   int64_t step = 0, cg_iterations = 0;
   double residual = INFINITY;
@@ -63,19 +63,11 @@ SolveResult solve_newton_on(const Mesh& m, const SolveOptions& opt, ForceField& 
     int64_t inverted = count_inverted(m, x);
     bool increment_done = residual < tol;
     while (!increment_done && step < opt.max_steps) {
-      field.linearize(model, x);
-      pressure.linearize(m, x, model.pressure_pa);
-      field.stiffness_diagonal(blocks);
-      const std::vector<Mat3> precond = block_jacobi(m, blocks);
+      linear->linearize(model, x);
       const double eta = std::isfinite(previous_norm)
                              ? std::clamp(0.9 * (norm / previous_norm) * (norm / previous_norm), 1e-3, 0.1)
                              : 0.1;
-      const LinearOperator K = [&](const std::vector<Vec3>& p, std::vector<Vec3>& kp) {
-        field.stiffness_product(p, kp);
-        pressure.add_product(p, kp);
-      };
-      const CgOutcome cg =
-          shifted_conjugate_gradients(m, K, blocks, precond, f, eta, opt.newton_max_cg_iterations, shift, d);
+      const CgOutcome cg = linear->solve(f, eta, opt.newton_max_cg_iterations, shift, d);
       cg_iterations += cg.iterations;
 
       // Backtracking on |f|: halve until it falls enough and no further tetrahedron inverts.
