@@ -4,13 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
-#include <stdexcept>
-#include <unordered_map>
 
 
 #include "core/error.h"
 #include "core/units.h"
 #include "solve/solve_on_device.h"
+#include "validate/tet_field.h"
 #include "validate/validate.h"
 
 namespace pneumo {
@@ -43,81 +42,6 @@ struct PlacementMeans {
   int64_t nodes = 0, inner_nodes = 0, outer_nodes = 0, steps = 0;
   double residual = 0;
 };
-
-// The piecewise-linear field of the tetrahedra at points of the rest frame. A point is carried by the
-// tetrahedron of its lattice cube that holds it (largest smallest barycentric weight); a point in no
-// meshed cube (the staircase lies inside the true surface there) by the tetrahedron of the nearest
-// meshed cube whose weights are least negative: a linear extrapolation over at most a cube.
-class TetField {
- public:
-  TetField(const Mesh& m, double cube_m) : m_(m), cube_m_(cube_m) {
-    origin_ = m.rest_m[0] - Vec3(m.node_lattice[0][0], m.node_lattice[0][1], m.node_lattice[0][2]) * cube_m;
-    for (std::size_t t = 0; t < m.tets.size(); ++t) {
-      Vec3 c = Vec3::Zero();
-      for (int32_t n : m.tets[t]) c += 0.25 * m.rest_m[n];
-      by_cube_[key(cell(c))].push_back(int32_t(t));
-    }
-  }
-
-  /// The field's value at rest point p (metres) from the node values `u`; `outside` tells whether no
-  /// meshed cube held p.
-  Vec3 at(const Vec3& p, const std::vector<Vec3>& u, bool& outside) const {
-    const std::array<int64_t, 3> c = cell(p);
-    int32_t best = -1;
-    std::array<double, 4> best_w{};
-    double best_min = -HUGE_VAL;
-    auto consider = [&](const std::array<int64_t, 3>& q) {
-      const auto it = by_cube_.find(key(q));
-      if (it == by_cube_.end()) return;
-      for (int32_t t : it->second) {
-        const std::array<double, 4> w = weights(t, p);
-        const double lo = *std::min_element(w.begin(), w.end());
-        if (lo > best_min) { best_min = lo; best = t; best_w = w; }
-      }
-    };
-    consider(c);
-    outside = best < 0;
-    for (int dz = -1; dz <= 1 && best < 0; ++dz)   // then the 26 neighbours together
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-          if (dx || dy || dz) consider({c[0] + dx, c[1] + dy, c[2] + dz});
-    if (best < 0) throw std::logic_error("validate_lame_sphere: a point on the sphere is more than a cube from the mesh");
-    Vec3 v = Vec3::Zero();
-    for (int i = 0; i < 4; ++i) v += best_w[i] * u[m_.tets[best][i]];
-    return v;
-  }
-
- private:
-  std::array<int64_t, 3> cell(const Vec3& p) const {
-    const Vec3 q = (p - origin_) / cube_m_;
-    return {int64_t(std::floor(q[0])), int64_t(std::floor(q[1])), int64_t(std::floor(q[2]))};
-  }
-  static int64_t key(const std::array<int64_t, 3>& c) {
-    return ((c[2] + (1 << 20)) << 42) | ((c[1] + (1 << 20)) << 21) | (c[0] + (1 << 20));
-  }
-  std::array<double, 4> weights(int32_t t, const Vec3& p) const {
-    const auto& q = m_.tets[t];
-    Mat3 D;
-    for (int i = 0; i < 3; ++i) D.col(i) = m_.rest_m[q[i + 1]] - m_.rest_m[q[0]];
-    const Vec3 l = D.inverse() * (p - m_.rest_m[q[0]]);
-    return {1.0 - l.sum(), l[0], l[1], l[2]};
-  }
-  const Mesh& m_;
-  double cube_m_;
-  Vec3 origin_;
-  std::unordered_map<int64_t, std::vector<int32_t>> by_cube_;
-};
-
-/// n points spread evenly over the unit sphere (the Fibonacci lattice), each standing for 1/n of its area.
-std::vector<Vec3> fibonacci_sphere(int n) {
-  std::vector<Vec3> d(n);
-  const double golden = M_PI * (3.0 - std::sqrt(5.0));
-  for (int i = 0; i < n; ++i) {
-    const double z = 1.0 - (2.0 * i + 1.0) / n, r = std::sqrt(1.0 - z * z);
-    d[i] = Vec3(r * std::cos(golden * i), r * std::sin(golden * i), z);
-  }
-  return d;
-}
 
 PlacementMeans solve_placement(const LameOptions& o, const Vec3& offset_cubes) {
   // The sphere is voxelised at voxel_mm (each voxel by its centre) and meshed with cubes of cube_mm,
