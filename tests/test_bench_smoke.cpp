@@ -120,6 +120,9 @@ TEST(BenchSmoke, QuickRunWritesEverySectionWithFiniteNumbers) {
     ASSERT_EQ(c["models"].size(), 2u) << c.dump();
     EXPECT_EQ(c["models"][1]["model"], "fem-neohookean");
     EXPECT_EQ(c["models"][1]["preset_solver"], "newton");
+    // The model to pick needs the real CT, which --quick leaves out: none, and the default named.
+    EXPECT_TRUE(c["model_pick"]["model"].is_null()) << c.dump();
+    EXPECT_EQ(c["model_pick"]["default_model"], "msd");
   }
 
   EXPECT_NE(slurp(md).find("## Speed against accuracy"), std::string::npos);

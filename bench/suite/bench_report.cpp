@@ -176,13 +176,15 @@ void material_models(std::ostringstream& md, const json& mm) {
        << num(r["wall_s"], "%.2f") << " |\n";
   if (!mm["real_ct"].empty()) {
     md << "\nThe real CT at each preset's cube size (all threads):\n\n| preset | model | solver | cube | nodes | s | "
-          "iterations | rise mm | cavity ml | inverted | stop |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+          "iterations | rise mm | cavity ml | viscera back mm | inverted | stop |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& r : mm["real_ct"])
       md << "| " << r["preset"].get<std::string>() << " | " << r["model"].get<std::string>() << " | "
          << r["solver"].get<std::string>() << " | " << num(r["cube_mm"], "%g") << " mm | " << r["nodes"] << " | "
          << num(r["wall_s"], "%.1f") << " | " << (r.contains("steps") ? r["steps"].dump() : "–") << " | "
          << (r.contains("anterior_rise_mm") ? num(r["anterior_rise_mm"], "%.1f") : "–") << " | "
          << (r.contains("cavity_volume_ml") ? num(r["cavity_volume_ml"], "%.0f") : "–") << " | "
+         << (r.contains("viscera_posterior_motion_mm") ? num(r["viscera_posterior_motion_mm"], "%.1f") : "–") << " | "
          << (r.contains("inverted_tetrahedra") ? r["inverted_tetrahedra"].dump() : "–") << " | "
          << r["stop_reason"].get<std::string>() << " |\n";
   }
@@ -207,6 +209,17 @@ void material_models(std::ostringstream& md, const json& mm) {
            << " s), the preset takes " << m["preset_solver"].get<std::string>()
            << (m["follows"].get<bool>() ? " (follows)" : " (does not follow)");
       md << ";";
+    }
+    if (c.contains("model_pick")) {
+      const json& p = c["model_pick"];
+      md << " the model to pick (the fastest real-CT row within the adult figures: rise 25–60 mm, 1.5–4 L, viscera "
+            "back ≥ 5 mm): ";
+      if (p["model"].is_null()) md << "none in this run";
+      else
+        md << p["model"].get<std::string>() << " with " << p["solver"].get<std::string>() << " ("
+           << num(p["wall_s"], "%.1f") << " s); the default model, " << p["default_model"].get<std::string>()
+           << (p["default_follows"].get<bool>() ? ", is it" : ", is not");
+      md << ".";
     }
     md << "\n";
   }

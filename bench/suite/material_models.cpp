@@ -97,6 +97,7 @@ json real_ct_row(BenchCase& c, int cube_voxels, SolverMethod method, double limi
     row["inverted_tetrahedra"] = r.inverted_tetrahedra;
     row["anterior_rise_mm"] = d.anterior_rise_mm;
     row["cavity_volume_ml"] = d.cavity_volume_ml;
+    row["viscera_posterior_motion_mm"] = d.anterior_viscera_posterior_motion_mm;
   } catch (const TimeLimit&) {
     row["wall_s"] = seconds_since(t0);
     row["converged"] = false;
@@ -204,6 +205,31 @@ json measure_throughput(BenchContext& ctx) {
                                    "reaches, not a ratio"}}}};
 }
 
+// Adult figures at 12–15 mmHg (issue "A human answer", docs/fidelity.md §4): an anterior rise of 25–60 mm,
+// 1.5–4 L of gas, the anterior half of the viscera moving back by 5 mm or more.
+bool within_human_figures(const json& r) {
+  return r.contains("viscera_posterior_motion_mm") && r["anterior_rise_mm"].get<double>() >= 25.0 &&
+         r["anterior_rise_mm"].get<double>() <= 60.0 && r["cavity_volume_ml"].get<double>() >= 1500.0 &&
+         r["cavity_volume_ml"].get<double>() <= 4000.0 && r["viscera_posterior_motion_mm"].get<double>() >= 5.0;
+}
+
+// Which model a user should pick at each preset, from the measurements: of the real-CT rows at that preset's
+// cube size that converged with 0 inverted tetrahedra and lie within the adult figures, the fastest; and whether
+// the default model (a scene that names none) is it.
+json pick_model(const json& real_ct, const std::string& preset) {
+  const json* pick = nullptr;
+  for (const auto& r : real_ct) {
+    if (r["preset"] != preset || !r["converged"].get<bool>() || r["inverted_tetrahedra"].get<int64_t>() != 0 ||
+        !within_human_figures(r))
+      continue;
+    if (!pick || r["wall_s"].get<double>() < (*pick)["wall_s"].get<double>()) pick = &r;
+  }
+  const std::string default_model = enum_name(SceneMaterial{}.model);
+  if (!pick) return {{"model", nullptr}, {"default_model", default_model}, {"default_follows", nullptr}};
+  return {{"model", (*pick)["model"]}, {"solver", (*pick)["solver"]}, {"wall_s", (*pick)["wall_s"]},
+          {"default_model", default_model}, {"default_follows", (*pick)["model"] == default_model}};
+}
+
 // The rule: the material model is the scene's physics, chosen by the user from the Lamé and real-CT tables; a preset
 // sets the cube size and, for each model, the solver. For each preset's cube size and each model, the benchmark's
 // pick is the fastest solver whose real-CT solve converged with 0 inverted tetrahedra; "follows" says whether the
@@ -233,7 +259,7 @@ json choose(const json& real_ct) {
       }
       per_model.push_back(m);
     }
-    out.push_back({{"preset", preset}, {"models", per_model}});
+    out.push_back({{"preset", preset}, {"models", per_model}, {"model_pick", pick_model(real_ct, preset)}});
   }
   return out;
 }
