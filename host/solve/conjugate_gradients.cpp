@@ -64,24 +64,30 @@ CgOutcome conjugate_gradients(const Mesh& m, const LinearOperator& A, const std:
   return out;
 }
 
-CgOutcome shifted_conjugate_gradients(const Mesh& m, const LinearOperator& A, const std::vector<Mat3>& blocks,
-                                      const std::vector<Mat3>& precond, const std::vector<Vec3>& b, double eta,
-                                      int max_iterations, Shift& shift, std::vector<Vec3>& d) {
-  const LinearOperator shifted = [&](const std::vector<Vec3>& p, std::vector<Vec3>& y) {
-    A(p, y);
-    if (shift.sigma > 0.0)
-      for (std::size_t n = 0; n < p.size(); ++n) y[n] += shift.sigma * (blocks[n] * p[n]);
-  };
+CgOutcome with_growing_shift(Shift& shift, const std::function<CgOutcome(double sigma)>& cg) {
   int iterations = 0;
   for (;;) {
-    CgOutcome cg = conjugate_gradients(m, shifted, precond, b, eta, max_iterations, d);
-    iterations += cg.iterations;
-    if (!cg.negative_curvature || shift.sigma >= Shift::kMax) {
-      cg.iterations = iterations;
-      return cg;
+    CgOutcome out = cg(shift.sigma);
+    iterations += out.iterations;
+    if (!out.negative_curvature || shift.sigma >= Shift::kMax) {
+      out.iterations = iterations;
+      return out;
     }
     shift.sigma = shift.sigma > 0.0 ? 10.0 * shift.sigma : Shift::kFirst;
   }
+}
+
+CgOutcome shifted_conjugate_gradients(const Mesh& m, const LinearOperator& A, const std::vector<Mat3>& blocks,
+                                      const std::vector<Mat3>& precond, const std::vector<Vec3>& b, double eta,
+                                      int max_iterations, Shift& shift, std::vector<Vec3>& d) {
+  return with_growing_shift(shift, [&](double sigma) {
+    const LinearOperator shifted = [&](const std::vector<Vec3>& p, std::vector<Vec3>& y) {
+      A(p, y);
+      if (sigma > 0.0)
+        for (std::size_t n = 0; n < p.size(); ++n) y[n] += sigma * (blocks[n] * p[n]);
+    };
+    return conjugate_gradients(m, shifted, precond, b, eta, max_iterations, d);
+  });
 }
 
 }  // namespace pneumo

@@ -36,6 +36,10 @@ struct Shift {
   void relax() { sigma = sigma > kFirst ? 0.1 * sigma : 0.0; }
   static constexpr double kFirst = 1e-3, kMax = 1e3;
 };
+/// The shift's growth around any CG: calls cg(σ), which solves (A + σ D) d = b once, with σ grown tenfold
+/// from 10⁻³ while it meets negative curvature, up to 10³; `iterations` counts every attempt's.
+CgOutcome with_growing_shift(Shift& shift, const std::function<CgOutcome(double sigma)>& cg);
+
 /// Solves (A + σ D) d = b as conjugate_gradients does, growing `shift` as it needs; `iterations`
 /// counts every attempt's. negative_curvature is set only when even σ = 10³ did not make CG complete.
 CgOutcome shifted_conjugate_gradients(const Mesh& m, const LinearOperator& A, const std::vector<Mat3>& blocks,

@@ -96,20 +96,13 @@ class ClNewtonLinearSolver final : public NewtonLinearSolver {
     double bb = 0.0;
     for (const Vec3& v : b) bb += v.squaredNorm();
     const double stop = eta * std::sqrt(bb);
-    int iterations = 0;
-    for (;;) {   // as shifted_conjugate_gradients: grow σ until CG completes
-      CgOutcome cg = conjugate_gradients(shift.sigma, stop, max_iterations);
-      iterations += cg.iterations;
-      if (!cg.negative_curvature || shift.sigma >= Shift::kMax) {
-        cg.iterations = iterations;
-        std::vector<cl_float4> raw(N_);
-        ctx_.queue().enqueueReadBuffer(d_, CL_TRUE, 0, N_ * sizeof(cl_float4), raw.data());
-        d.resize(N_);
-        for (int64_t n = 0; n < N_; ++n) d[n] = Vec3(raw[n].s[0], raw[n].s[1], raw[n].s[2]);
-        return cg;
-      }
-      shift.sigma = shift.sigma > 0.0 ? 10.0 * shift.sigma : Shift::kFirst;
-    }
+    const CgOutcome cg =
+        with_growing_shift(shift, [&](double sigma) { return conjugate_gradients(sigma, stop, max_iterations); });
+    std::vector<cl_float4> raw(N_);
+    ctx_.queue().enqueueReadBuffer(d_, CL_TRUE, 0, N_ * sizeof(cl_float4), raw.data());
+    d.resize(N_);
+    for (int64_t n = 0; n < N_; ++n) d[n] = Vec3(raw[n].s[0], raw[n].s[1], raw[n].s[2]);
+    return cg;
   }
 
  private:
