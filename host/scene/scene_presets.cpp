@@ -10,22 +10,24 @@ namespace pneumo {
 namespace {
 
 // Chosen from the Pareto front of bench/results/2026-11-23-bench.md: the medium phantom (1.5 mm voxels) at 12 mmHg,
-// the CPU reference on 1 thread, errors at skin and cavity-surface points against the static solver at 4.5 mm cubes
-// and tolerance 1e-5. The cube size is what buys accuracy there: below 1e-2 the tolerance changed the error by
-// < 0.03 mm at every cube size, and the dynamic schemes reached the same error as the static solver at the same
-// cube size in 10-100× the time. "accurate" keeps 1e-3 (same error there, +0.8 s) as a margin for cases stiffer or
-// more nonlinear than the phantom. The texts say what each measured to buy (solve time, RMS / max error).
+// errors at skin and cavity-surface points against the static solver at 4.5 mm cubes and tolerance 1e-5. The cube
+// size is what buys accuracy there: below 1e-2 the tolerance changed the error by < 0.05 mm at every cube size, and
+// the dynamic schemes reached the static solver's error at the same cube size in 10-400× the time. "accurate" keeps
+// 1e-3 as a margin for cases stiffer or more nonlinear than the phantom. Since the geometry is resolved at the voxel
+// the phantom's front allows coarser cubes (bench/results/2026-12-05-bench.md); the sizes stay, as the real CT's
+// convergence study supports them (docs/fidelity.md §4). The texts say what each measured to buy in that last run
+// (solve time on all threads, RMS / max error).
 //
-// The finite elements take Newton at every preset (bench/results/2026-12-02-material-models.md, the real CT): the
-// static solver (FIRE) did not finish within 300 s at 9 and 6 mm cubes, where Newton took 61 and 190 s, and on the
-// FEM example scene with its soft, compressible viscera it diverges at 12 mm cubes where Newton converges in 15
-// iterations (docs/fem.md). The solver follows the model; the model stays the scene's physics.
+// The finite elements take Newton at every preset (bench/results/2026-12-05-bench.md, the real CT): on the FEM
+// example scene, with its soft, compressible viscera, the static solver (FIRE) diverges at every preset where Newton
+// converges in 15-23 iterations (on 2026-12-02, on the stiffer viscera then, it did not finish within 300 s at 9 and
+// 6 mm cubes; docs/fem.md). The solver follows the model; the model stays the scene's physics.
 const PresetSettings kPreview{SolverMethod::Static, SolverMethod::Newton, 12.0, 1e-2,
-                              "measured: solve 0.17 s, error RMS 2.5 mm, max 7.5 mm"};
+                              "measured: solve 0.36 s, error RMS 0.93 mm, max 5.6 mm"};
 const PresetSettings kBalanced{SolverMethod::Static, SolverMethod::Newton, 9.0, 1e-2,
-                               "measured: solve 0.41 s, error RMS 1.7 mm, max 5.4 mm"};
+                               "measured: solve 0.86 s, error RMS 0.90 mm, max 10.6 mm"};
 const PresetSettings kAccurate{SolverMethod::Static, SolverMethod::Newton, 6.0, 1e-3,
-                               "measured: solve 3.1 s, error RMS 0.63 mm, max 2.1 mm"};
+                               "measured: solve 5.4 s, error RMS 0.64 mm, max 4.8 mm"};
 
 }  // namespace
 
@@ -58,11 +60,11 @@ std::optional<ScenePreset> find_preset(const nlohmann::json& scene) {
 
 const std::string& preset_reference_text() {
   static const std::string text = [] {
-    std::string t = "Speed against accuracy, measured by `pneumo bench` (docs/performance.md, bench/results/2026-11-23-bench.md: the "
-                    "medium phantom, CPU 1 thread, error at skin and cavity points against 4.5 mm cubes): sets "
-                    "mesh.cube_mm, solver.method and solver.residual_tolerance unless the scene gives them; the finite "
-                    "elements (material.model fem-*) take newton at every preset, where the static solver did not "
-                    "finish or diverged on the real CT (docs/fem.md). \"none\": the defaults.";
+    std::string t = "Speed against accuracy, measured by `pneumo bench` (docs/performance.md, bench/results/2026-12-05-bench.md: the "
+                    "medium phantom, the springs, CPU all threads, error at skin and cavity points against 4.5 mm cubes): "
+                    "sets mesh.cube_mm, solver.method and solver.residual_tolerance unless the scene gives them; the "
+                    "finite elements (material.model fem-*) take newton at every preset, where the static solver "
+                    "diverged on the real CT (docs/fem.md). \"none\": the defaults.";
     for (const ScenePreset p : {ScenePreset::Preview, ScenePreset::Balanced, ScenePreset::Accurate}) {
       const PresetSettings& s = preset_settings(p);
       char b[256];
