@@ -26,6 +26,9 @@ packages=(
   libgtest-dev googletest libbenchmark-dev python3-vtk9 python3-numpy python3-nibabel python3-pydicom libinsighttoolkit5-dev
   # headless Chromium loads report.html and takes a screenshot of it (tests/test_report_browser.cpp)
   chromium
+  # cohorts and sweeps (workflow/Snakefile, tests/test_workflow.cpp): Snakemake runs them, matplotlib draws
+  # the gathered figure
+  snakemake python3-matplotlib
 )
 if [ "${1:-}" = "--peers" ]; then
   packages+=(python3-scipy libglew-dev)
