@@ -180,7 +180,8 @@ void material_models(std::ostringstream& md, const json& mm) {
           "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& r : mm["real_ct"])
       md << "| " << r["preset"].get<std::string>() << " | " << r["model"].get<std::string>() << " | "
-         << r["solver"].get<std::string>() << " | " << num(r["cube_mm"], "%g") << " mm | " << r["nodes"] << " | "
+         << r["solver"].get<std::string>() << " | " << num(r["cube_mm"], "%g") << " mm | "
+         << (r["nodes"].is_number() ? r["nodes"].dump() : "–") << " | "
          << num(r["wall_s"], "%.1f") << " | " << (r.contains("steps") ? r["steps"].dump() : "–") << " | "
          << (r.contains("anterior_rise_mm") ? num(r["anterior_rise_mm"], "%.1f") : "–") << " | "
          << (r.contains("cavity_volume_ml") ? num(r["cavity_volume_ml"], "%.0f") : "–") << " | "
