@@ -19,6 +19,12 @@ namespace pneumo::ocl {
 /// size). The one place it is written: kernels see it as PNEUMO_WORK_GROUP (default_build_options).
 constexpr std::size_t kWorkGroupSize = 64;
 
+/// The global size that covers n work items (at least one) in whole work-groups of kWorkGroupSize;
+/// kernels return early for ids ≥ n.
+inline std::size_t global_size(int64_t n) {
+  return (std::size_t(n > 1 ? n : 1) + kWorkGroupSize - 1) / kWorkGroupSize * kWorkGroupSize;
+}
+
 struct DeviceInfo {
   int platform_index = -1, device_index = -1;
   std::string platform_name, platform_version;

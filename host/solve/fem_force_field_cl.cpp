@@ -21,8 +21,6 @@ constexpr int kStateE = 27, kStatePsi = 32;
 const std::string kStateOptions = "-DkStateFloats=" + std::to_string(kStateFloats) +
                                   " -DS_E=" + std::to_string(kStateE) + " -DS_PSI=" + std::to_string(kStatePsi);
 
-std::size_t global_size(int64_t n) { return (std::size_t(std::max<int64_t>(n, 1)) + kLocal - 1) / kLocal * kLocal; }
-
 class ClFemForceField final : public ForceField {
  public:
   ClFemForceField(ocl::Context& ctx, const Mesh& m, FemLaw law)
@@ -90,17 +88,17 @@ class ClFemForceField final : public ForceField {
     auto& q = ctx_.queue();
     if (T_ > 0) {
       ocl::set_args(k_forces_, state_, dm_inv_, consts_, group_of_tet_, ebar_, law_int(), cl_int(T_), tet_force_);
-      q.enqueueNDRangeKernel(k_forces_, cl::NullRange, cl::NDRange(global_size(T_)), cl::NDRange(kLocal));
+      q.enqueueNDRangeKernel(k_forces_, cl::NullRange, cl::NDRange(ocl::global_size(T_)), cl::NDRange(kLocal));
     }
     const bool loads = model.pressure_pa != 0.0 && R_ > 0;
     if (loads) {
       ocl::set_args(k_load_, u_, rest_x_, load_nodes_, load_c_, float(model.pressure_pa), cl_int(R_), load_force_);
-      q.enqueueNDRangeKernel(k_load_, cl::NullRange, cl::NDRange(global_size(R_)), cl::NDRange(kLocal));
+      q.enqueueNDRangeKernel(k_load_, cl::NullRange, cl::NDRange(ocl::global_size(R_)), cl::NDRange(kLocal));
     }
     const Vec3& g = model.gravity_m_s2;
     ocl::set_args(k_gather_, tet_force_, tet_start_, tet_item_, load_force_, load_start_, load_item_, cl_int(loads),
                   mass_, cl_float4{{float(g[0]), float(g[1]), float(g[2]), 0.0f}}, cl_int(N_), f_);
-    q.enqueueNDRangeKernel(k_gather_, cl::NullRange, cl::NDRange(global_size(N_)), cl::NDRange(kLocal));
+    q.enqueueNDRangeKernel(k_gather_, cl::NullRange, cl::NDRange(ocl::global_size(N_)), cl::NDRange(kLocal));
     download(f_, f);
     ++evaluations_;
   }
@@ -137,25 +135,25 @@ class ClFemForceField final : public ForceField {
     auto& q = ctx_.queue();
     if (T_ > 0) {
       ocl::set_args(k_dF_, p, tets_buf_, dm_inv_, state_, law_int(), cl_int(T_), dF_);
-      q.enqueueNDRangeKernel(k_dF_, cl::NullRange, cl::NDRange(global_size(T_)), cl::NDRange(kLocal));
+      q.enqueueNDRangeKernel(k_dF_, cl::NullRange, cl::NDRange(ocl::global_size(T_)), cl::NDRange(kLocal));
       average(dF_, 10, 9, debar_);
       ocl::set_args(k_dforces_, state_, dm_inv_, consts_, group_of_tet_, ebar_, debar_, dF_, law_int(), float(b_),
                     cl_int(T_), tet_force_);
-      q.enqueueNDRangeKernel(k_dforces_, cl::NullRange, cl::NDRange(global_size(T_)), cl::NDRange(kLocal));
+      q.enqueueNDRangeKernel(k_dforces_, cl::NullRange, cl::NDRange(ocl::global_size(T_)), cl::NDRange(kLocal));
     }
     ocl::set_args(k_gather_, tet_force_, tet_start_, tet_item_, load_force_, load_start_, load_item_, cl_int(0),
                   mass_, cl_float4{{0, 0, 0, 0}}, cl_int(N_), kp);
-    q.enqueueNDRangeKernel(k_gather_, cl::NullRange, cl::NDRange(global_size(N_)), cl::NDRange(kLocal));
+    q.enqueueNDRangeKernel(k_gather_, cl::NullRange, cl::NDRange(ocl::global_size(N_)), cl::NDRange(kLocal));
   }
 
   void stiffness_diagonal(std::vector<Mat3>& blocks) override {
     auto& q = ctx_.queue();
     if (T_ > 0) {
       ocl::set_args(k_diagonal_, state_, dm_inv_, consts_, law_int(), float(b_), cl_int(T_), blocks_);
-      q.enqueueNDRangeKernel(k_diagonal_, cl::NullRange, cl::NDRange(global_size(T_)), cl::NDRange(kLocal));
+      q.enqueueNDRangeKernel(k_diagonal_, cl::NullRange, cl::NDRange(ocl::global_size(T_)), cl::NDRange(kLocal));
     }
     ocl::set_args(k_gather_diagonal_, blocks_, tet_start_, tet_item_, cl_int(N_), node_blocks_);
-    q.enqueueNDRangeKernel(k_gather_diagonal_, cl::NullRange, cl::NDRange(global_size(N_)), cl::NDRange(kLocal));
+    q.enqueueNDRangeKernel(k_gather_diagonal_, cl::NullRange, cl::NDRange(ocl::global_size(N_)), cl::NDRange(kLocal));
     std::vector<cl_float4> raw(3 * N_);
     q.enqueueReadBuffer(node_blocks_, CL_TRUE, 0, raw.size() * sizeof(cl_float4), raw.data());
     blocks.resize(N_);
@@ -184,7 +182,7 @@ class ClFemForceField final : public ForceField {
     const int64_t G = int64_t(groups_->weight.size());
     ocl::set_args(k_average_, per_tet, cl_int(stride), cl_int(offset), weight_, group_begin_, group_tets_,
                   inv_weight_, cl_int(G), out);
-    ctx_.queue().enqueueNDRangeKernel(k_average_, cl::NullRange, cl::NDRange(global_size(G)), cl::NDRange(kLocal));
+    ctx_.queue().enqueueNDRangeKernel(k_average_, cl::NullRange, cl::NDRange(ocl::global_size(G)), cl::NDRange(kLocal));
   }
 
   void build_groups(bool mean_dilatation) {
@@ -217,7 +215,7 @@ class ClFemForceField final : public ForceField {
     q.enqueueWriteBuffer(u_, CL_TRUE, 0, N_ * sizeof(cl_float4), to_float4(u).data());
     if (T_ > 0) {
       ocl::set_args(k_states_, u_, tets_buf_, dm_inv_, consts_, law_int(), float(b_), cl_int(T_), state_);
-      q.enqueueNDRangeKernel(k_states_, cl::NullRange, cl::NDRange(global_size(T_)), cl::NDRange(kLocal));
+      q.enqueueNDRangeKernel(k_states_, cl::NullRange, cl::NDRange(ocl::global_size(T_)), cl::NDRange(kLocal));
       average(state_, kStateFloats, kStateE, ebar_);
     }
   }

@@ -11,8 +11,6 @@ namespace {
 constexpr std::size_t kLocal = ocl::kWorkGroupSize;
 constexpr int kBlock = 8;            // nodes per work-item in node_forces (W in msd_forces.cl)
 
-std::size_t global_size(int64_t n) { return (std::size_t(n) + kLocal - 1) / kLocal * kLocal; }
-
 int max_degree(const Csr& c, int64_t nodes) {
   int64_t d = 0;
   for (int64_t n = 0; n < nodes; ++n) d = std::max(d, c.end(n) - c.begin(n));
@@ -236,12 +234,12 @@ void ClForceEvaluator::evaluate(const ForceModel& model, Nodes which) {
   const bool pressure = model.pressure_pa != 0.0 && loads_ > 0, volume = model.volume_stiffness_pa != 0.0;
   if (pressure) {
     ocl::set_args(k_load_, x_, rest_x_, load_nodes_, load_c_, float(model.pressure_pa), cl_int(loads_), load_force_);
-    q.enqueueNDRangeKernel(k_load_, cl::NullRange, cl::NDRange(global_size(loads_)), cl::NDRange(kLocal));
+    q.enqueueNDRangeKernel(k_load_, cl::NullRange, cl::NDRange(ocl::global_size(loads_)), cl::NDRange(kLocal));
   }
   if (volume) {
     ocl::set_args(k_tet_, x_, rest_x_, tets_buf_, tet_fraction_, float(model.volume_stiffness_pa), cl_int(tets_),
                   tet_force_);
-    q.enqueueNDRangeKernel(k_tet_, cl::NullRange, cl::NDRange(global_size(tets_)), cl::NDRange(kLocal));
+    q.enqueueNDRangeKernel(k_tet_, cl::NullRange, cl::NDRange(ocl::global_size(tets_)), cl::NDRange(kLocal));
   }
   const int64_t blocks = which == Nodes::All ? blocks_ : free_blocks_;
   ocl::set_args(k_node_, x_, v_, mass_, cl_int(blocks), block_nodes_, spring_begin_, spring_node_, spring_k_,
@@ -251,7 +249,7 @@ void ClForceEvaluator::evaluate(const ForceModel& model, Nodes which) {
                 cl_float4{{float(model.gravity_m_s2[0]), float(model.gravity_m_s2[1]), float(model.gravity_m_s2[2]), 0.0f}},
                 f_);
   if (blocks > 0)
-    q.enqueueNDRangeKernel(k_node_, cl::NullRange, cl::NDRange(global_size(blocks)), cl::NDRange(kLocal));
+    q.enqueueNDRangeKernel(k_node_, cl::NullRange, cl::NDRange(ocl::global_size(blocks)), cl::NDRange(kLocal));
 }
 
 std::vector<Vec3> ClForceEvaluator::download_positions(cl::Buffer& u) {

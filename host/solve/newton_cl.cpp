@@ -14,8 +14,6 @@ namespace {
 constexpr std::size_t kLocal = ocl::kWorkGroupSize;
 constexpr std::size_t kDotGroups = 256;   // partial sums per dot product
 
-std::size_t global_size(int64_t n) { return (std::size_t(std::max<int64_t>(n, 1)) + kLocal - 1) / kLocal * kLocal; }
-
 std::vector<cl_float4> columns(const std::vector<Mat3>& blocks) {
   std::vector<cl_float4> out(std::max<std::size_t>(3 * blocks.size(), 1), cl_float4{{0, 0, 0, 0}});
   for (std::size_t n = 0; n < blocks.size(); ++n)
@@ -159,7 +157,7 @@ class ClNewtonLinearSolver final : public NewtonLinearSolver {
   template <class... A>
   void run(cl::Kernel& k, int64_t items, const A&... args) {
     ocl::set_args(k, args...);
-    ctx_.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(global_size(items)), cl::NDRange(kLocal));
+    ctx_.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(ocl::global_size(items)), cl::NDRange(kLocal));
   }
 
   void write(cl::Buffer& buf, const std::vector<cl_float4>& v) {
