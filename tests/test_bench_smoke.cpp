@@ -122,7 +122,7 @@ TEST(BenchSmoke, QuickRunWritesEverySectionWithFiniteNumbers) {
     EXPECT_EQ(c["models"][1]["preset_solver"], "newton");
     // The model to pick needs the real CT, which --quick leaves out: none, and the default named.
     EXPECT_TRUE(c["model_pick"]["model"].is_null()) << c.dump();
-    EXPECT_EQ(c["model_pick"]["default_model"], "msd");
+    EXPECT_EQ(c["model_pick"]["default_model"], "fem-neohookean");
   }
 
   EXPECT_NE(slurp(md).find("## Speed against accuracy"), std::string::npos);

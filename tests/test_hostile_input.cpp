@@ -24,6 +24,7 @@
 #include <stdexcept>
 
 #include "cli_test_support.h"
+#include "springs_support.h"
 #include "tiny_case_support.h"
 
 namespace pneumo {
@@ -229,6 +230,7 @@ std::vector<Row> rows() {
       {"time_step_beyond_the_limit",
        [](D d) {
          json s = tiny_case_scene_json();
+         s["material"] = springs_material_json();   // the explicit scheme takes the springs only
          s["solver"] = {{"method", "explicit"}, {"dt_ms", 5.0}};
          return write_tiny_case(d, s);
        },

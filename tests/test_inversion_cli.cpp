@@ -15,6 +15,7 @@
 
 #include "cli_test_support.h"
 #include "opencl_test_support.h"
+#include "springs_support.h"
 #include "tiny_case_support.h"
 
 namespace pneumo {
@@ -26,7 +27,9 @@ namespace fs = std::filesystem;
 
 std::string inverting_case(const ScratchDir& d, const std::string& method, const std::string& on_inverted) {
   json s = tiny_case_scene_json();
-  s["material"] = {{"young_kpa", 6}, {"volume_stiffness_kpa", 0}};
+  s["material"] = springs_material_json();   // a soft spring lattice inverts; the elements resist it
+  s["material"]["young_kpa"] = 6;
+  s["material"]["volume_stiffness_kpa"] = 0;
   s["solver"] = {{"method", method}, {"on_inverted", on_inverted}};
   return write_tiny_case(d, s);
 }

@@ -19,6 +19,7 @@
 #include "cli_test_support.h"
 #include "io/volume_io.h"
 #include "io_test_support.h"
+#include "springs_support.h"
 #include "tiny_case_support.h"
 
 namespace pneumo {
@@ -68,6 +69,7 @@ TEST(KillDuringRun, WhatItLeavesIsWholeOrAbsentAndTheNextRunCleansUp) {
   // machine a slow measure would put the last kills after the killed runs had finished.
   ScratchDir d;
   nlohmann::json s = tiny_case_scene_json();
+  s["material"] = springs_material_json();   // the explicit scheme takes the springs only
   s["solver"] = {{"method", "explicit"}};
   s["load"]["ramp_ms"] = 2000;
   s["render"]["width"] = 480;

@@ -141,7 +141,14 @@ TEST(SceneDefaults, MatchMethodAndTable) {
   EXPECT_EQ(s.material.spring_model, SpringModel::Nonlinear);
   EXPECT_FALSE(s.material.gravity);
   EXPECT_EQ(s.load.pressure_mmhg, 12.0);
-  EXPECT_EQ(s.solver.method, SolverMethod::Static);
+  EXPECT_EQ(s.solver.method, SolverMethod::Newton);
+  // The material `pneumo bench` picks at every preset (docs/fidelity.md §4-5), one set for every CT.
+  EXPECT_EQ(s.material.model, MaterialModel::FemNeoHookean);
+  EXPECT_EQ(s.material.stiffening, 10.0);
+  EXPECT_EQ(s.material.poisson_ratio, 0.45);
+  EXPECT_EQ(s.material.viscera_young_kpa, 5.5);
+  EXPECT_EQ(s.material.viscera_poisson_ratio, 0.25);
+  EXPECT_EQ(s.material.fat_young_kpa, 3.0);
   EXPECT_EQ(s.solver.newmark_beta, 0.25);
   EXPECT_EQ(s.solver.newmark_gamma, 0.5);
   EXPECT_EQ(s.solver.kitasaka_step, 0.3);
@@ -191,6 +198,12 @@ TEST(SceneRoundTrip, EveryKeyChangesItsOwnValueOnly) {
     if (path == "material.model") {   // the finite elements need the Newton solver (scene_validate.cpp)
       companions.push_back(json::json_pointer("/solver/method"));
       changed[companions.back()] = "newton";
+      companions.push_back(json::json_pointer("/material/stiffening"));   // the co-rotational law has none
+      changed[companions.back()] = 0.0;
+    }
+    if (path == "material.spring_model" || path == "material.volume_stiffness_kpa") {   // the springs' own keys
+      companions.push_back(json::json_pointer("/material/model"));
+      changed[companions.back()] = "msd";
     }
     if (path == "material.tilt_deg") {   // a tilt needs gravity (scene_validate.cpp)
       companions.push_back(json::json_pointer("/material/gravity"));
@@ -477,7 +490,11 @@ TEST(SceneRules, PortTargetsAndPathKeyframes) {
 
 TEST(SceneRules, FiniteElementsNeedAStaticSolverAndRefuseTheSpringsOwnKeys) {
   // Each rule of check_material_model, with the message a user reads.
-  EXPECT_NO_THROW(parse_scene({{"material", {{"model", "fem-corotational"}}}}, kOrigin));   // the static solver
+  // The co-rotational law is linear: chosen without a stiffening of its own, it takes 0, not the default's b.
+  EXPECT_EQ(parse_scene({{"material", {{"model", "fem-corotational"}}}}, kOrigin).material.stiffening, 0.0);
+  EXPECT_EQ(parse_scene({{"material", {{"model", "fem-neohookean"}}}}, kOrigin).material.stiffening, 10.0);
+  EXPECT_NO_THROW(parse_scene({{"material", {{"model", "fem-corotational"}}}, {"solver", {{"method", "static"}}}},
+                              kOrigin));
   EXPECT_NO_THROW(parse_scene({{"material", {{"model", "fem-corotational"}}}, {"solver", {{"method", "implicit-euler"}}}},
                               kOrigin));
   const json fem = {{"material", {{"model", "fem-corotational"}}}, {"solver", {{"method", "explicit"}}}};
@@ -488,7 +505,8 @@ TEST(SceneRules, FiniteElementsNeedAStaticSolverAndRefuseTheSpringsOwnKeys) {
   EXPECT_CONTAINS(error_of(j), "material.stiffening = 5");
   j = {{"material", {{"model", "fem-neohookean"}, {"volume_stiffness_kpa", 60}}}, {"solver", {{"method", "newton"}}}};
   EXPECT_CONTAINS(error_of(j), "material.volume_stiffness_kpa = 60");
-  j = {{"material", {{"model", "fem-neohookean"}, {"stiffening", 5}, {"wall_poisson_ratio", 0.49}}},
+  j = {{"material", {{"model", "fem-neohookean"}, {"stiffening", 5}, {"wall_poisson_ratio", 0.49},
+                     {"viscera_poisson_ratio", nullptr}}},
        {"solver", {{"method", "newton"}}}};
   const Scene s = parse_scene(j, kOrigin);
   EXPECT_DOUBLE_EQ(s.poisson_for(Role::Wall, 0), 0.49);
@@ -498,7 +516,9 @@ TEST(SceneRules, FiniteElementsNeedAStaticSolverAndRefuseTheSpringsOwnKeys) {
 TEST(SceneRules, Queries) {
   Scene s = parse_scene({{"roles", {{"wall_labels", json::array({2})}, {"viscera_labels", {5, 6}}, {"fixed_labels", json::array({9})},
                                     {"unlisted_label_role", "viscera"}}},
-                         {"material", {{"young_kpa", 50}, {"wall_young_kpa", 24}, {"label_young_kpa", json::array({{{"label", 6}, {"young_kpa", 3}}})}}}},
+                         {"material", {{"young_kpa", 50}, {"wall_young_kpa", 24}, {"viscera_young_kpa", nullptr},
+                                       {"fat_young_kpa", nullptr},
+                                       {"label_young_kpa", json::array({{{"label", 6}, {"young_kpa", 3}}})}}}},
                         kOrigin);
   const std::vector<Role> roles = s.roles.label_roles();
   ASSERT_EQ(roles.size(), 65536u);
@@ -509,7 +529,7 @@ TEST(SceneRules, Queries) {
   EXPECT_EQ(s.young_kpa_for(Role::Wall, 2), 24.0);
   EXPECT_EQ(s.young_kpa_for(Role::Viscera, 5), 50.0);
   EXPECT_EQ(s.young_kpa_for(Role::Viscera, 6), 3.0);
-  // Fat by HU: off by default; on, inside [-190, -30] HU (ends included) unless the label has its own E.
+  // Fat by HU: off when null; on, inside [-190, -30] HU (ends included) unless the label has its own E.
   EXPECT_EQ(s.young_kpa_for(Role::Wall, 2, -100.0f), 24.0);
   s.material.fat_young_kpa = 2.0;
   EXPECT_EQ(s.young_kpa_for(Role::Wall, 2, -100.0f), 2.0);
@@ -622,7 +642,7 @@ TEST(SceneReference, ListsEveryKey) {
                               "## `render.paths[].keyframes[]` (each item)", "## `material.label_young_kpa[]` (each item)"})
     EXPECT_CONTAINS(md, heading);
   for (const char* row : {"| `pressure_mmhg` | number | `12.0` | 0 to 100; 0 (rest) or at least 0.1 | mmHg |", "| `fov_deg` | number | `70.0` |",
-                          "| `method` | enum | `\"static\"` | \"static\", \"explicit\", \"newmark\", \"kitasaka2004\", \"newton\", "
+                          "| `method` | enum | `\"newton\"` | \"static\", \"explicit\", \"newmark\", \"kitasaka2004\", \"newton\", "
                           "\"implicit-euler\" |"})
     EXPECT_CONTAINS(md, row);
 }

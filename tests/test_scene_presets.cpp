@@ -21,7 +21,9 @@ TEST(ScenePresets, EachPresetSetsItsSettings) {
     EXPECT_EQ(s.preset, p);
     ASSERT_TRUE(s.mesh.cube_mm.has_value());
     EXPECT_EQ(*s.mesh.cube_mm, want.cube_mm);
-    EXPECT_EQ(s.solver.method, want.method);
+    // The default model, the finite elements, takes the preset's solver for them: Newton.
+    EXPECT_EQ(s.solver.method, preset_method(want, s.material.model));
+    EXPECT_EQ(s.solver.method, SolverMethod::Newton);
     EXPECT_EQ(s.solver.residual_tolerance, want.residual_tolerance);
   }
 }
@@ -32,7 +34,7 @@ TEST(ScenePresets, TheScenesOwnKeysWin) {
                               kOrigin);
   EXPECT_EQ(s.solver.residual_tolerance, 0.5);
   EXPECT_EQ(*s.mesh.cube_mm, 7.0);
-  EXPECT_EQ(s.solver.method, preset_settings(ScenePreset::Preview).method);
+  EXPECT_EQ(s.solver.method, preset_settings(ScenePreset::Preview).fem_method);
 }
 
 TEST(ScenePresets, NoneAndAbsentLeaveTheDefaults) {

@@ -65,6 +65,7 @@ TEST(Simulate, PressureVolumeCurveGrowsAndEndsWhereADirectRunEnds) {
   // whose displacement error is a fraction of a percent of the rise) and become the main result.
   ScratchDir dir;
   Scene scene = phantom_scene(dir);
+  scene.mesh.cube_voxels = 4;   // 16 mm cubes, 9 k nodes: the curve against the direct run on the same mesh
   const Simulation direct = simulate_scene(scene);
   scene.load.pressure_curve_mmhg = {0.0, 4.0, 8.0};
   const Simulation sim = simulate_scene(scene);
@@ -103,7 +104,7 @@ TEST(Simulate, WritesMeshesMetricsAndTheSceneUsed) {
                           "mean_wall_displacement_mm", "anterior_rise_mm", "cavity_volume_ml", "inverted_tetrahedra"})
     EXPECT_TRUE(m.contains(key)) << key;
   EXPECT_EQ(m["nodes"], sim.mesh.stats.nodes);
-  EXPECT_EQ(m["solver"], "static");
+  EXPECT_EQ(m["solver"], "newton");   // the default
   // The VTU declares the mesh's sizes (ParaView reads them from here).
   std::ifstream vtu(out + "/mesh_deformed.vtu");
   std::stringstream ss;
@@ -170,17 +171,21 @@ void expect_same_equilibrium_on_opencl(Scene scene) {
 
 TEST(Simulate, OpenClReachesTheCpuEquilibriumOnThePhantom) {
   ScratchDir dir;
-  expect_same_equilibrium_on_opencl(phantom_scene(dir));
+  Scene scene = phantom_scene(dir);
+  scene.mesh.cube_voxels = 4;   // 16 mm cubes, 9 k nodes: the devices compared on the same mesh
+  expect_same_equilibrium_on_opencl(scene);
 }
 
 TEST(Simulate, OpenClReachesTheCpuEquilibriumOnTheRealCt) {
   PNEUMO_REQUIRE_REAL_CT();
   Progress::set_enabled(false);
-  expect_same_equilibrium_on_opencl(load_scene(std::string(PNEUMO_SOURCE_DIR) + "/scenes/totalseg_example.json"));
+  // The springs' scene; the default elements' devices on the real CT: the next test.
+  expect_same_equilibrium_on_opencl(
+      load_scene(std::string(PNEUMO_SOURCE_DIR) + "/scenes/totalseg_example_springs.json"));
 }
 
 TEST(Simulate, RealCtInflatesWithFiniteElementsOnEveryDevice) {
-  // scenes/totalseg_example_fem.json (Demiray's law, ν = 0.45, Newton) at 12 mm cubes, the preview
+  // scenes/totalseg_example.json (the default: Demiray's law, ν = 0.45, Newton) at 12 mm cubes, the preview
   // size. Compared against published adult figures at 12–15 mmHg (docs/fidelity.md): an anterior
   // rise of 25–60 mm (the range, from several centimetres in patients) and a cavity of more
   // than 1 L (adults hold 2–4 L; the mesh's cavity without the warp's gas pieces measured 1.52 L).
@@ -189,7 +194,7 @@ TEST(Simulate, RealCtInflatesWithFiniteElementsOnEveryDevice) {
   // Then every OpenCL device against the CPU, within the device tolerance above.
   PNEUMO_REQUIRE_REAL_CT();
   Progress::set_enabled(false);
-  Scene scene = load_scene(std::string(PNEUMO_SOURCE_DIR) + "/scenes/totalseg_example_fem.json");
+  Scene scene = load_scene(std::string(PNEUMO_SOURCE_DIR) + "/scenes/totalseg_example.json");
   scene.mesh.cube_voxels = 4;
   const Simulation sim = simulate_scene(scene);
   ASSERT_TRUE(sim.result.converged) << sim.result.stop_reason;

@@ -95,9 +95,11 @@ std::set<int> ids_of(const Volume& v) {
 // simulation is the slow part):
 //  - the outputs lie on the input's grid (dims, spacing, origin, direction within 1e-4 mm, the
 //    NIfTI round trip's float precision) in the input's voxel types, so they overlay it in a viewer;
-//  - the gas opens a cavity: gas voxels (−1000 HU, label 250) whose columns hold the wall anterior
-//    and viscera posterior to them (method.md §7: between the wall and the viscera), at least 90 %
-//    of them (the rest sit at the cavity's lateral ends, where the wall meets the viscera side on);
+//  - the gas opens a cavity: gas voxels (−1000 HU, label 250) between the wall and the viscera
+//    (method.md §7), at least 90 % of them: their anterior-posterior column holds the wall anterior and
+//    viscera posterior, or, in the lateral gutters where the gas reaches round the viscera (82 % and
+//    99 % of it with the default elements, whose viscera give way), their left-right row holds the wall
+//    on one side and viscera on the other;
 //    its volume is in metrics.json as cavity_volume_ml, beside the mesh's own estimate from the
 //    enclosed volume of the cavity surfaces: they agree within a factor of two (they differ by the
 //    staircase of the surfaces and by gas outside the CT's field of view);
@@ -140,19 +142,22 @@ TEST_F(WarpPipeline, ThePhantomAt12MmHgOpensAGasCavityBetweenWallAndViscera) {
         if (lab.value(i, j, k) != 250) continue;
         ++gas;
         EXPECT_EQ(ct.value(i, j, k), -1000.0);
-        bool wall_above = false, viscera_below = false;
-        for (int64_t jj = j + 1; jj < d[1] && !wall_above; ++jj) {
-          const int l = int(lab.value(i, jj, k));
-          wall_above = l != 250 && role_of[l] == Role::Wall;
-        }
-        for (int64_t jj = j - 1; jj >= 0 && !viscera_below; --jj) {
-          const int l = int(lab.value(i, jj, k));
-          viscera_below = l != 250 && role_of[l] == Role::Viscera;
-        }
-        between += wall_above && viscera_below;
+        // Whether a role lies somewhere along the row from (i, j, k) in steps of (di, dj), past the gas.
+        const auto finds = [&](int64_t di, int64_t dj, Role role) {
+          for (int64_t ii = i + di, jj = j + dj; ii >= 0 && jj >= 0 && ii < d[0] && jj < d[1]; ii += di, jj += dj) {
+            const int l = int(lab.value(ii, jj, k));
+            if (l != 250 && role_of[l] == role) return true;
+          }
+          return false;
+        };
+        // In front of the viscera: wall anterior, viscera posterior. In the lateral gutters, where going back
+        // meets the flank wall again: wall on one side along left-right, viscera on the other.
+        between += (finds(0, 1, Role::Wall) && finds(0, -1, Role::Viscera)) ||
+                   (finds(1, 0, Role::Wall) && finds(-1, 0, Role::Viscera)) ||
+                   (finds(-1, 0, Role::Wall) && finds(1, 0, Role::Viscera));
       }
   EXPECT_EQ(gas, voxels);
-  EXPECT_GE(double(between), 0.9 * double(gas)) << "gas voxels between wall (anterior) and viscera (posterior)";
+  EXPECT_GE(double(between), 0.9 * double(gas)) << "gas voxels between wall and viscera";
   std::printf("phantom small at 12 mmHg: cavity %lld voxels = %.0f ml (mesh estimate %.0f ml), %.1f %% between wall "
               "and viscera\n", (long long)voxels, ml, mesh_ml, 100.0 * double(between) / double(gas));
 

@@ -26,7 +26,9 @@ struct BenchCase {
   WarpBox warp_box() const { return WarpBox{roles.pad.lo, ct.geometry().dims}; }
 };
 
-/// The phantom of `size` with its scene; `cube_voxels` > 0 overrides the scene's L. Logging is quieted while
+/// The phantom of `size` with its scene and Nimura's springs (scene.h use_nimura_springs: the throughput, speed-accuracy
+/// and stability sections measure the springs; the material-model section sets its own); `cube_voxels` > 0 overrides
+/// the scene's L. Logging is quieted while
 /// the phantom's scene names labels its CT lacks.
 BenchCase phantom_case(PhantomSize size, int cube_voxels = 0);
 /// Reuses a case's phantom and roles (they do not depend on L) for another cube size.

@@ -166,8 +166,7 @@ constexpr double kProductBytesPerTet = (64 + 16 + 36 + 36 + 40) + 8 + (160 + 36 
 
 json measure_throughput(BenchContext& ctx) {
   BenchCase c = phantom_case(PhantomSize::Small, ctx.quick() ? 4 : 0);
-  c.scene.material.model = MaterialModel::FemNeoHookean;
-  c.scene.material.stiffening = 10.0;
+  c.scene.material = SceneMaterial{};   // the default: neo-Hookean elements with Demiray's b = 10
   remesh(c, c.mesh.cube_voxels);
   ForceModel model = solve_options_from_scene(c.scene).forces;
   model.damping = false;

@@ -12,8 +12,8 @@ Run add_bench(CLI::App& app) {
       "bench", "Measure every stage on every device, the solvers' speed against accuracy and their stable time "
                "steps (a full run takes up to an hour on 2 cores; --quick is the seconds-long smoke run)");
   auto o = std::make_shared<bench::BenchOptions>();
-  o->real_ct_scene = "scenes/totalseg_example.json";
-  o->real_ct_fem_scene = "scenes/totalseg_example_fem.json";
+  o->real_ct_scene = "scenes/totalseg_example_springs.json";
+  o->real_ct_fem_scene = "scenes/totalseg_example.json";
   cmd->add_flag("--quick", o->quick, "Smoke run: the small phantom, few repetitions (checks the harness, not the machine)");
   cmd->add_option("--json", o->json_path, "Write the results as JSON");
   cmd->add_option("--markdown", o->markdown_path, "Write the results as Markdown, and the speed-accuracy plot beside it (.svg)");

@@ -48,21 +48,28 @@ struct LabelYoung {
 struct SceneMaterial {
   double density_kg_m3 = 1096.0;  // Nimura (§4)
   double young_kpa = 60.0;        // Nimura (§4)
-  std::optional<double> wall_young_kpa, viscera_young_kpa;
+  std::optional<double> wall_young_kpa;
+  // The healthy liver in vivo by transient elastography (Roulot 2008: 5.49 ± 1.59 kPa); null = young_kpa.
+  std::optional<double> viscera_young_kpa = 5.5;
   std::vector<LabelYoung> label_young_kpa;
   // Fat by density: wall and viscera voxels whose HU lies in [fat_hu_min, fat_hu_max] (the adipose
   // window of CT body-composition studies) take fat_young_kpa unless their label has its own value.
-  std::optional<double> fat_young_kpa;
+  std::optional<double> fat_young_kpa = 3.0;   // the upper end of 1-3 kPa for fat; null = off
   double fat_hu_min = -190.0, fat_hu_max = -30.0;
   double damping_ratio = 0.4;     // ζ, Nimura (§4)
   double spring_scale = 1.0;      // as published; 0.925 matches the lattice to E (§4)
   SpringModel spring_model = SpringModel::Nonlinear;  // rotation-invariant (§5)
-  MaterialModel model = MaterialModel::Msd;           // springs, or finite elements (docs/fem.md)
+  // What `pneumo bench` picks at every preset (docs/fidelity.md §4): the springs cannot move the viscera.
+  MaterialModel model = MaterialModel::FemNeoHookean;
   // ν of the finite elements (the springs' is fixed at 1/4): Bano 2012 used 0.49 for the wall.
   double poisson_ratio = 0.45;
-  std::optional<double> wall_poisson_ratio, viscera_poisson_ratio;
+  std::optional<double> wall_poisson_ratio;
+  // A calibration, not a tissue's ratio: the room the viscera find outside the mesh (docs/fidelity.md §5).
+  std::optional<double> viscera_poisson_ratio = 0.25;
   bool mean_dilatation = true;    // FEM: volumetric strain averaged per cube, against locking
-  double stiffening = 0.0;        // b of the exponential spring law (solve/forces.h); 0 = linear
+  // b of the stiffening law (springs: solve/forces.h; fem-neohookean: Demiray); 0 = linear. 10 gives the
+  // real CT McDougall's pressure-volume shape (docs/fidelity.md §3): a calibration.
+  double stiffening = 10.0;
   std::optional<double> volume_stiffness_kpa;          // unset: see effective_volume_stiffness_kpa()
   bool gravity = false;           // the CT already shows the body under gravity (§5)
   bool gravity_compensation = true;   // solve from the unloaded shape whose weight gives the CT (Bano 2012)
@@ -82,7 +89,7 @@ struct SceneLoad {
 };
 
 struct SceneSolver {
-  SolverMethod method = SolverMethod::Static;
+  SolverMethod method = SolverMethod::Newton;   // converges for every model; FIRE diverges on the FEM
   double dt_ms = 0.0;                    // 0 = dt_safety × the stability bound (§6)
   double dt_safety = 0.5;
   int64_t max_steps = 100000;
@@ -167,6 +174,11 @@ struct Scene {
   /// (the 2004 scheme needs it: its springs alone let tetrahedra collapse), 0 for the others.
   double effective_volume_stiffness_kpa() const;
 };
+
+/// Nimura's mass-spring lattice (§4), the model pneumo started from: the springs with every tissue at
+/// young_kpa, linear in tension (stiffening 0) and no fat window. The bench's springs sections and the
+/// tests of what only the springs do (the explicit, Newmark and 2004 schemes) use it.
+void use_nimura_springs(SceneMaterial& m);
 
 /// Reads a scene file. InputError (one line, naming the file) on any problem: missing file,
 /// invalid JSON (with line and column), unknown key, wrong type, value out of range.

@@ -177,12 +177,13 @@ const Table<SceneMaterial>& material_table() {
       {"wall_young_kpa", &SceneMaterial::wall_young_kpa, "kPa", in(kMinKPa, kMaxKPa),
        "E of wall tetrahedra; unset = young_kpa (Bano: 24)."},
       {"viscera_young_kpa", &SceneMaterial::viscera_young_kpa, "kPa", in(kMinKPa, kMaxKPa),
-       "E of viscera tetrahedra; unset = young_kpa (Bano: 15)."},
+       "E of viscera tetrahedra; null = young_kpa. Default 5.5: the healthy liver in vivo by transient elastography "
+       "(Roulot 2008: 5.49 ± 1.59 kPa in 429 adults); Bano used 15 from tissue tests (docs/fidelity.md §5)."},
       {"label_young_kpa", &SceneMaterial::label_young_kpa, label_young_table(), any(),
        "E per label id, over the role's value: [{\"label\": 5, \"young_kpa\": 3}]."},
       {"fat_young_kpa", &SceneMaterial::fat_young_kpa, "kPa", in(kMinKPa, kMaxKPa),
        "E of wall and viscera voxels in the fat window [fat_hu_min, fat_hu_max] unless their label has one; "
-       "unset = off (their role's E). Fat is far softer than muscle: 1-3 kPa (docs/fidelity.md)."},
+       "null = off (their role's E). Default 3, the upper end of 1-3 kPa for fat (docs/fidelity.md §3)."},
       {"fat_hu_min", &SceneMaterial::fat_hu_min, "HU", in(-1024, 3071), "Lower end of the fat window (-190)."},
       {"fat_hu_max", &SceneMaterial::fat_hu_max, "HU", in(-1024, 3071), "Upper end of the fat window (-30)."},
       {"damping_ratio", &SceneMaterial::damping_ratio, "", in(0, 10),
@@ -194,20 +195,26 @@ const Table<SceneMaterial>& material_table() {
       {"model", &SceneMaterial::model, "", any(),
        "\"msd\": the mass-spring lattice (§4-5); \"fem-corotational\": co-rotational linear tetrahedra (as SOFA, "
        "Bano 2012); \"fem-neohookean\": neo-Hookean tetrahedra, with Demiray's stiffening when stiffening > 0. The "
-       "FEM models need solver.method \"newton\" (the fast choice), \"static\" or \"implicit-euler\" (docs/fem.md)."},
+       "FEM models need solver.method \"newton\" (the fast choice), \"static\" or \"implicit-euler\" (docs/fem.md). "
+       "The default is the model `pneumo bench` picks at every preset: only the elements move the viscera back by "
+       "the millimetres patients show (docs/fidelity.md §4)."},
       {"poisson_ratio", &SceneMaterial::poisson_ratio, "", in(0, 0.49),
        "ν of the finite elements unless overridden (Bano 2012: 0.49 for the wall); the springs' ν is 1/4."},
       {"wall_poisson_ratio", &SceneMaterial::wall_poisson_ratio, "", in(0, 0.49),
        "ν of wall finite elements; unset = poisson_ratio."},
       {"viscera_poisson_ratio", &SceneMaterial::viscera_poisson_ratio, "", in(0, 0.49),
-       "ν of viscera finite elements; unset = poisson_ratio."},
+       "ν of viscera finite elements; null = poisson_ratio. Default 0.25: a calibration, not a tissue's ratio (solid "
+       "organs are nearly incompressible); it lumps the room the viscera find outside the mesh (diaphragm, emptying "
+       "veins, bowel contents), so their anterior half moves back by 5 mm or more (docs/fidelity.md §5)."},
       {"mean_dilatation", &SceneMaterial::mean_dilatation, "", any(),
        "FEM: average the volumetric strain over each cube's tetrahedra (B-bar), so nearly incompressible tissue does "
        "not lock; false = per tetrahedron (docs/fem.md)."},
       {"stiffening", &SceneMaterial::stiffening, "", in(0, 50),
        "b of the strain-stiffening spring law: tension k·l0·(exp(b·strain) - 1)/b in tension, the small-strain "
        "stiffness kept; 0 = linear (nonlinear springs only; docs/fidelity.md). With fem-neohookean: b of Demiray's "
-       "law, shear energy μ/(2b)(exp(b(I1 - 3)) - 1)."},
+       "law, shear energy μ/(2b)(exp(b(I1 - 3)) - 1). Default 10: a calibration that gives the real CT McDougall's "
+       "pressure-volume shape, V(15)/V(30) near 0.67 (docs/fidelity.md §3); 0 when the scene picks "
+       "fem-corotational, a linear law."},
       {"volume_stiffness_kpa", &SceneMaterial::volume_stiffness_kpa, "kPa", at_least(0),
        "k_v of Kitasaka's volume-preserving force (§5). Unset: young_kpa for kitasaka2004, 0 (off) for the "
        "other solvers."},
@@ -256,7 +263,8 @@ const Table<SceneSolver>& solver_table() {
        "\"kitasaka2004\": Kitasaka's quasi-static scheme (§6); \"newton\": Newton with preconditioned conjugate "
        "gradients (static; every material model; on OpenCL for the finite elements); \"implicit-euler\": "
        "backward Euler with conjugate gradients and Rayleigh damping (dynamic, as Bano 2012 with SOFA; every "
-       "material model; CPU). The finite elements take \"static\", \"newton\" or \"implicit-euler\"."},
+       "material model; CPU). The finite elements take \"static\", \"newton\" or \"implicit-euler\". Default "
+       "\"newton\": it converges for every model, where FIRE diverges on the elements (bench/results)."},
       {"dt_ms", &SceneSolver::dt_ms, "ms", in(0, 1000),
        "Time step of explicit and newmark; 0 = dt_safety × the stability bound (§6)."},
       {"dt_safety", &SceneSolver::dt_safety, "", above(0, 1), "Fraction of the stability bound used when dt_ms = 0."},

@@ -157,6 +157,20 @@ json read_json_file(const std::string& path) {
   }
 }
 
+bool material_key_given(const nlohmann::json& scene, const char* key) {
+  const auto m = scene.find("material");
+  return m != scene.end() && m->is_object() && m->contains(key);
+}
+
+/// The material model a scene's JSON names, else the default's (a misspelt one is left to the table, which
+/// names the allowed values).
+MaterialModel named_material_model(const nlohmann::json& scene) {
+  const MaterialModel fallback = SceneMaterial{}.model;
+  if (!material_key_given(scene, "model")) return fallback;
+  const nlohmann::json& name = scene["material"]["model"];
+  return name.is_string() ? enum_from_name<MaterialModel>(name.get<std::string>()).value_or(fallback) : fallback;
+}
+
 }  // namespace
 
 Scene parse_scene(const nlohmann::json& j, const std::string& origin_path) {
@@ -173,14 +187,14 @@ Scene parse_scene(const nlohmann::json& j, const std::string& origin_path) {
   // A misspelt preset is left to the table, which names the allowed values.
   nlohmann::json merged = j;
   if (const std::optional<ScenePreset> p = find_preset(j); p && *p != ScenePreset::None) {
-    // The solver follows the material model the scene names (a misspelt one is left to the table).
-    MaterialModel model = MaterialModel::Msd;
-    if (const auto m = j.find("material"); m != j.end() && m->is_object())
-      if (const auto name = m->find("model"); name != m->end() && name->is_string())
-        model = enum_from_name<MaterialModel>(name->get<std::string>()).value_or(MaterialModel::Msd);
-    merged = preset_patch(*p, model);
+    // The solver follows the material model the scene names, or the default's.
+    merged = preset_patch(*p, named_material_model(j));
     merged.merge_patch(j);
   }
+  // Demiray's b is the default's stiffening; the co-rotational law is linear and has none, so choosing
+  // it without a stiffening of its own takes 0 (a stiffening it is given is refused by validate_scene).
+  if (named_material_model(j) == MaterialModel::FemCorotational && !material_key_given(j, "stiffening"))
+    merged["material"]["stiffening"] = 0.0;
   scene_detail::scene_table().read(s, merged, scene_detail::At{&ctx, ""});
   scene_detail::validate_scene(s, ctx);
   s.path = origin_path;

@@ -35,6 +35,13 @@ double Scene::poisson_for(Role role, int label) const {
   return material.poisson_ratio;
 }
 
+void use_nimura_springs(SceneMaterial& m) {
+  m.model = MaterialModel::Msd;
+  m.stiffening = 0.0;
+  m.fat_young_kpa.reset();
+  m.viscera_young_kpa.reset();
+}
+
 double Scene::effective_volume_stiffness_kpa() const {
   if (material.volume_stiffness_kpa) return *material.volume_stiffness_kpa;
   // Kitasaka gives no value for k_v. k_v = E adds E to the lattice's bulk modulus (0.721 E, shear
