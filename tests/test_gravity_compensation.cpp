@@ -233,7 +233,8 @@ TEST(GravityCompensation, OnTheRealCTTheUnloadedShapeStandsAtTheCTAndTheGasCarri
   // 1 % of the sag plus 10 µm (the solve's 1e-3 residual); and the inflated wall at 12 mmHg, whose weight
   // (about ρ g × 3 cm ≈ 2.4 mmHg) the gas now carries instead of the viscera, against the same scene without
   // gravity: it must rise less, and the run must report the compensation. The springs' scene: on the default
-  // elements, with their soft compressible viscera, the wall rises more under gravity (docs/gravity.md).
+  // elements the compressible viscera (ν 0.25) sag under their own weight and drag the bonded wall down while
+  // the unloaded shape is found, and the wall rises more once the gas releases it (docs/gravity.md).
   Progress::set_enabled(false);
   Scene scene = load_scene(std::string(PNEUMO_SOURCE_DIR) + "/scenes/totalseg_example_springs.json");
   scene.mesh.cube_voxels = 4;
