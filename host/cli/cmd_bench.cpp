@@ -4,6 +4,7 @@
 #include "cli/commands.h"
 #include "suite/bench_suite.h"
 #include "suite/peer_warp.h"
+#include "suite/pipeline_bench.h"
 
 namespace pneumo::cli {
 
@@ -22,6 +23,10 @@ Run add_bench(CLI::App& app) {
   cmd->add_option("--real-ct-fem", o->real_ct_fem_scene,
                   "The real CT's scene with finite elements, beside the springs' in the material-model rows")
       ->capture_default_str();
+  auto pipeline = std::make_shared<bool>(false);
+  cmd->add_flag("--pipeline", *pipeline,
+                "Instead of the suite: a CT file to the first view, `pneumo run` per preset and device on the medium and "
+                "large phantoms, stage by stage (--quick: the small phantom, preview, the CPU)");
   auto peer = std::make_shared<bench::PeerWarpOptions>();
   cmd->add_option("--peer-warp", peer->data_dir,
                   "Instead of the suite: warp the peers' phantom (DIR/phantom.mhd from ../shared/peers/phantom.py) "
@@ -38,7 +43,17 @@ Run add_bench(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-field", peer->skip_field,
                 "--peer-warp: skip disp_pneumo.mhd (the dense field through PointMap that compare_warp.sh hands ITK)");
-  return [o, peer] {
+  return [o, peer, pipeline] {
+    if (*pipeline) {
+      bench::PipelineBenchOptions p;
+      p.quick = o->quick;
+      p.json_path = o->json_path;
+      p.markdown_path = o->markdown_path;
+      const nlohmann::json doc = bench::run_pipeline_bench(p);
+      if (o->json_path.empty() && o->markdown_path.empty()) std::printf("%s", bench::pipeline_bench_markdown(doc).c_str());
+      else std::fprintf(stderr, "[bench] pipeline done in %.0f s\n", doc["wall_time_s"].get<double>());
+      return 0;
+    }
     if (!peer->data_dir.empty()) {
       const nlohmann::json doc = bench::run_peer_warp(*peer);
       std::printf("%s\n", doc.dump(2).c_str());
