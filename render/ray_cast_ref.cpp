@@ -96,21 +96,45 @@ RenderImage render_reference(const RenderVolume& volume, const ViewCamera& cam, 
       const auto [ta, tb] = clip_to_box(origin_idx, didx, volume.geometry.dims);
       const double t_lo = std::max(ta, cam.near_mm);
       if (!(t_lo <= tb)) continue;
-      const double j = s.jitter ? jitter_offset(px, py, s.jitter_seed) : 0.0;
+      double j = s.jitter ? jitter_offset(px, py, s.jitter_seed) : 0.0;
       int64_t k = std::max<int64_t>(0, int64_t(std::ceil((t_lo - cam.near_mm) / s.step_mm - j)));
       Vec3 C = Vec3::Zero();
       double A = 0.0;
       double depth = std::numeric_limits<double>::infinity();
+      const auto clear_at = [&](const Vec3& q) {
+        return (s.hide_exterior_air && smp.label(q) == kExteriorAirLabel) || s.tf.opacity_at(smp.hu(q)) <= 0.0;
+      };
+      double t_clear = -1.0;   // the last t known to contribute nothing, while no sample since has; else −1
       for (;; ++k) {
-        const double t = cam.near_mm + (double(k) + j) * s.step_mm;
+        double t = cam.near_mm + (double(k) + j) * s.step_mm;
         if (t > tb) break;
         if (t < t_lo) continue;
-        const Vec3 p = origin_idx + t * didx;
+        Vec3 p = origin_idx + t * didx;
+        if (clear_at(p)) {
+          t_clear = t;
+          continue;
+        }
+        if (t_clear >= 0.0) {
+          // Step 2b: entering matter from clear space, bisect for where the opacity begins and go on from there.
+          double lo = t_clear, hi = t;
+          for (int r = 0; r < kEntryBisections; ++r) {
+            const double mid = 0.5 * (lo + hi);
+            (clear_at(origin_idx + mid * didx) ? lo : hi) = mid;
+          }
+          t = hi + 0.5 * s.step_mm;   // the first sample half a step in: a midpoint sum from the entry on
+          j = (t - cam.near_mm) / s.step_mm - double(k);
+          t_clear = -1.0;
+          if (t > tb) break;
+          p = origin_idx + t * didx;
+          if (clear_at(p)) {   // a layer thinner than half a step
+            t_clear = t;
+            continue;
+          }
+        }
+        t_clear = -1.0;
         const uint16_t id = smp.label(p);
-        if (s.hide_exterior_air && id == kExteriorAirLabel) continue;
         const double h = smp.hu(p);
         const double alpha = s.tf.opacity_at(h);
-        if (alpha <= 0.0) continue;
         const double a = 1.0 - std::pow(1.0 - std::min(alpha, 1.0), exponent);
         Vec3 c = s.tf.colour_at(h);
         if (s.show_labels) {

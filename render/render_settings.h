@@ -11,6 +11,13 @@
 //    the corrected α′ at every integer HU and interpolates the table linearly; the reference
 //    evaluates the piecewise-linear function and the correction at the sample's HU.) With hide_exterior_air, a
 //    sample whose nearest voxel is labelled kExteriorAirLabel contributes nothing (exterior views).
+// 2b. Entry: a sample that contributes, right after one that did not (or, in the GL path, after an
+//    empty block it jumped over), is moved to half a step past where the opacity begins (found by
+//    kEntryBisections bisections of [t_clear, t] on "contributes"), and the following samples go
+//    on a step apart from there: a midpoint sum of the opacity from the entry, whatever the step.
+//    Without it the first sample of a surface lies anywhere up to a step inside it, in bands that
+//    follow the step lattice (wood grain). A moved sample that contributes nothing (a layer
+//    thinner than half a step) counts as clear.
 // 3. Labels: the nearest voxel's id picks an RGBA colour; c ← mix(c, label rgb, label_opacity·a).
 // 4. Shading (Phong with a headlight at the tip): gradient g (HU per voxel index) by trilinear
 //    interpolation, at the sample, of per-voxel central differences pre-computed once per volume
@@ -50,6 +57,7 @@ inline constexpr double kOpacityUnitMm = 1.0;       // Δs_ref of the opacity co
 inline constexpr double kEarlyTermination = 0.99;   // stop compositing once A exceeds this
 inline constexpr double kDepthOpacity = 0.5;        // "first surface": A reaches this
 inline constexpr double kFlatGradient = 1e-3;       // HU/mm below which a sample has no normal
+inline constexpr int kEntryBisections = 6;          // step 2b: the entry found to Δs/64
 
 /// Per-pixel start offset in [0, 1) for jitter: an integer hash of (px, py, seed); the GLSL copy
 /// in shaders/raycast.frag uses the same operations on 32-bit unsigned integers.

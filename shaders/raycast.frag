@@ -50,6 +50,11 @@ const uint kExteriorAir = 65535u;
 const float kEarlyTermination = 0.99;
 const float kDepthOpacity = 0.5;
 const float kFlatGradient = 1e-3;
+const int kEntryBisections = 6;   // render_settings.h, model step 2b: the entry found to Δs/64
+
+vec4 tf_at(float h) { return textureLod(u_tf, vec2((h - u_tf_hu_min + 0.5) / u_tf_size, 0.5), 0.0); }
+
+float hu_at(vec3 idx) { return textureLod(u_vol, (idx + 0.5) * u_inv_dims, 0.0).r * u_hu_scale; }
 
 uint label_at(vec3 idx) {
   ivec3 v = clamp(ivec3(floor(idx + 0.5)), ivec3(0), u_dims_i - 1);
@@ -107,6 +112,7 @@ void main() {
   float inv_falloff2 = 1.0 / (u_falloff * u_falloff);
   vec3 C = vec3(0.0);
   float A = 0.0;
+  float t_clear = -1.0;   // the last t known to contribute nothing, while no sample since has; else -1
   for (;; ++k) {
     float t = u_near + (float(k) + j) * u_step;
     if (t > t_hi) break;
@@ -115,7 +121,9 @@ void main() {
     // Empty-space skipping, in a loop of its own so that a jump costs only the occupancy fetch:
     // jump to the first sample at or beyond the far face of each empty block.
     ivec3 b = clamp(ivec3(p / u_block), ivec3(0), u_blocks - 1);  // p ≥ 0: truncation is floor
+    bool jumped = false;
     while (texelFetch(u_occupancy, b, 0).r == 0u) {
+      jumped = true;
       vec3 te = (vec3(b) * u_block + far_face - o) * inv_d;
       float t_exit = min(min(te.x, te.y), te.z);
       k = max(k + 1, int(ceil((t_exit - u_near) / u_step - j)));
@@ -125,17 +133,50 @@ void main() {
       b = clamp(ivec3(p / u_block), ivec3(0), u_blocks - 1);
     }
     if (t > t_hi) break;
+    // The lattice point before t lay in an empty block: as the reference, which samples it, sees it clear.
+    if (jumped) t_clear = t - u_step;
 #if defined(LABELS) || defined(HIDE_EXTERIOR)
     uint id = label_at(p);
 #endif
 #ifdef HIDE_EXTERIOR
-    if (id == kExteriorAir) continue;
+    if (id == kExteriorAir) { t_clear = t; continue; }
 #endif
     vec3 tex = (p + 0.5) * u_inv_dims;
     vec4 v = textureLod(u_vol, tex, 0.0);
     float h = v.r * u_hu_scale;
-    vec4 tf = textureLod(u_tf, vec2((h - u_tf_hu_min + 0.5) / u_tf_size, 0.5), 0.0);
-    if (tf.a <= 0.0) continue;
+    vec4 tf = tf_at(h);
+    if (tf.a <= 0.0) { t_clear = t; continue; }
+    if (t_clear >= 0.0) {
+      // Entering matter from clear space (model step 2b): bisect for where the opacity begins and take the
+      // first sample half a step past it, so a surface's samples sit where it is, not where the lattice fell.
+      float lo = t_clear, hi = t;
+      for (int r = 0; r < kEntryBisections; ++r) {
+        float mid = 0.5 * (lo + hi);
+        vec3 q = o + mid * d;
+        bool clear = tf_at(hu_at(q)).a <= 0.0;
+#ifdef HIDE_EXTERIOR
+        clear = clear || label_at(q) == kExteriorAir;
+#endif
+        if (clear) lo = mid; else hi = mid;
+      }
+      t = hi + 0.5 * u_step;   // the first sample half a step in: a midpoint sum from the entry on
+      j = (t - u_near) / u_step - float(k);   // the following samples a step apart from here
+      t_clear = -1.0;
+      if (t > t_hi) break;
+      p = o + t * d;
+#if defined(LABELS) || defined(HIDE_EXTERIOR)
+      id = label_at(p);
+#endif
+#ifdef HIDE_EXTERIOR
+      if (id == kExteriorAir) { t_clear = t; continue; }
+#endif
+      tex = (p + 0.5) * u_inv_dims;
+      v = textureLod(u_vol, tex, 0.0);
+      h = v.r * u_hu_scale;
+      tf = tf_at(h);
+      if (tf.a <= 0.0) { t_clear = t; continue; }   // a layer thinner than half a step
+    }
+    t_clear = -1.0;
     float a = tf.a;  // already corrected for the step
     vec3 c = tf.rgb;
 #ifdef LABELS
