@@ -37,6 +37,17 @@ TEST(ScenePresets, TheScenesOwnKeysWin) {
   EXPECT_EQ(s.solver.method, preset_settings(ScenePreset::Preview).fem_method);
 }
 
+TEST(ScenePresets, ANullTheSceneGivesStillSwitchesItsDefaultOff) {
+  // A preset fills only the keys the scene lacks: a null the scene gives (how a default is switched off) must
+  // survive, not be dropped as RFC 7386 drops nulls when a patch is merged.
+  const Scene s = parse_scene(json{{"preset", "preview"}, {"material", {{"viscera_young_kpa", nullptr},
+                                                                         {"fat_young_kpa", nullptr}}}},
+                              kOrigin);
+  EXPECT_FALSE(s.material.viscera_young_kpa.has_value());
+  EXPECT_FALSE(s.material.fat_young_kpa.has_value());
+  EXPECT_EQ(*s.mesh.cube_mm, preset_settings(ScenePreset::Preview).cube_mm);
+}
+
 TEST(ScenePresets, NoneAndAbsentLeaveTheDefaults) {
   const Scene none = parse_scene(json{{"preset", "none"}}, kOrigin), absent = parse_scene(json::object(), kOrigin);
   EXPECT_EQ(none.echo(), absent.echo());

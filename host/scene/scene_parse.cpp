@@ -157,18 +157,34 @@ json read_json_file(const std::string& path) {
   }
 }
 
-bool material_key_given(const nlohmann::json& scene, const char* key) {
-  const auto m = scene.find("material");
-  return m != scene.end() && m->is_object() && m->contains(key);
-}
-
 /// The material model a scene's JSON names, else the default's (a misspelt one is left to the table, which
 /// names the allowed values).
 MaterialModel named_material_model(const nlohmann::json& scene) {
   const MaterialModel fallback = SceneMaterial{}.model;
-  if (!material_key_given(scene, "model")) return fallback;
-  const nlohmann::json& name = scene["material"]["model"];
-  return name.is_string() ? enum_from_name<MaterialModel>(name.get<std::string>()).value_or(fallback) : fallback;
+  if (!scene.is_object()) return fallback;
+  const auto m = scene.find("material");
+  if (m == scene.end() || !m->is_object()) return fallback;
+  const auto name = m->find("model");
+  if (name == m->end() || !name->is_string()) return fallback;
+  return enum_from_name<MaterialModel>(name->get<std::string>()).value_or(fallback);
+}
+
+/// Adds the keys of `defaults` that `scene` lacks, object by object. Not RFC 7386's merge patch of the scene over
+/// the defaults: that would drop the scene's nulls, and null is how a scene switches a default off.
+void fill_absent(nlohmann::json& scene, const nlohmann::json& defaults) {
+  if (!scene.is_object()) return;   // the table names the wrong type
+  for (const auto& [key, value] : defaults.items()) {
+    const auto it = scene.find(key);
+    if (it == scene.end()) scene[key] = value;
+    else if (it->is_object() && value.is_object()) fill_absent(*it, value);
+  }
+}
+
+/// The defaults a model changes: the co-rotational law is linear and has no stiffening, so the default's b
+/// (Demiray's) becomes 0 for it; a stiffening the scene gives is refused by validate_scene.
+nlohmann::json model_patch(MaterialModel model) {
+  if (model == MaterialModel::FemCorotational) return {{"material", {{"stiffening", 0.0}}}};
+  return nlohmann::json::object();
 }
 
 }  // namespace
@@ -185,16 +201,13 @@ Scene parse_scene(const nlohmann::json& j, const std::string& origin_path) {
   Scene s;
   // A preset supplies values for the keys the scene does not give itself (merge_patch: the scene's keys win).
   // A misspelt preset is left to the table, which names the allowed values.
+  // Defaults that depend on the material model the scene names (or the default's) fill the keys the scene does
+  // not give: the preset's, whose solver follows the model, and the model's own.
+  const MaterialModel model = named_material_model(j);
   nlohmann::json merged = j;
-  if (const std::optional<ScenePreset> p = find_preset(j); p && *p != ScenePreset::None) {
-    // The solver follows the material model the scene names, or the default's.
-    merged = preset_patch(*p, named_material_model(j));
-    merged.merge_patch(j);
-  }
-  // Demiray's b is the default's stiffening; the co-rotational law is linear and has none, so choosing
-  // it without a stiffening of its own takes 0 (a stiffening it is given is refused by validate_scene).
-  if (named_material_model(j) == MaterialModel::FemCorotational && !material_key_given(j, "stiffening"))
-    merged["material"]["stiffening"] = 0.0;
+  if (const std::optional<ScenePreset> p = find_preset(j); p && *p != ScenePreset::None)
+    fill_absent(merged, preset_patch(*p, model));
+  fill_absent(merged, model_patch(model));
   scene_detail::scene_table().read(s, merged, scene_detail::At{&ctx, ""});
   scene_detail::validate_scene(s, ctx);
   s.path = origin_path;
