@@ -141,8 +141,7 @@ TEST_P(DeterminismPerSolver, TwoRunsEndBitIdentical) {
   nlohmann::json j = testing_support::tiny_case_scene_json();
   j["solver"]["method"] = method;
   // The explicit, Newmark and 2004 schemes take the springs only; the others the default material.
-  if (method == "explicit" || method == "newmark" || method == "kitasaka2004")
-    j["material"] = testing_support::springs_material_json();
+  if (!solves_force_fields(*enum_from_name<SolverMethod>(method))) j["material"] = testing_support::springs_material_json();
   j["device"] = device;
   Progress::set_enabled(false);
   const Scene scene = load_scene(testing_support::write_tiny_case(dir, j));

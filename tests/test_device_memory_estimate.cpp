@@ -16,7 +16,6 @@
 #include "core/progress.h"
 #include "opencl_test_support.h"
 #include "pipeline/scene_stages.h"
-#include "springs_support.h"
 #include "pipeline/simulate.h"
 #include "pipeline/warp_stage.h"
 #include "scene/scene.h"
@@ -63,7 +62,7 @@ class DeviceMemoryEstimate : public ::testing::TestWithParam<std::string> {
     Progress::set_enabled(false);
     log::set_level(log::Level::Quiet);
     scene_ = load_scene(write_tiny_case(dir_));
-    use_springs(scene_);   // solve_opencl is the springs' device solve; the elements' estimate is its own test
+    use_nimura_springs(scene_.material);   // solve_opencl is the springs' device solve; the elements' estimate is its own test
     scene_.device = GetParam();
     sim_ = prepare_simulation(scene_);
     ctx_ = ocl::Context::shared(ocl::parse_device_spec(GetParam()));
