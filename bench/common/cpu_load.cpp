@@ -23,11 +23,14 @@ CpuSample cpu_sample() {
     const std::size_t len = std::fread(buf, 1, sizeof buf - 1, f);
     buf[len] = 0;
     std::fclose(f);
-    // Fields after the command name (which may hold spaces): state is field 3, utime 14, stime 15.
+    // Fields after the command name (which may hold spaces): state is field 3, utime 14, stime 15, and the
+    // waited-for children's cutime 16, cstime 17.
     if (const char* p = std::strrchr(buf, ')')) {
       unsigned long long utime = 0, stime = 0;
-      if (std::sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &utime, &stime) == 2)
-        s.own_s = double(utime + stime) / tick;
+      long long cutime = 0, cstime = 0;
+      if (std::sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu %lld %lld", &utime, &stime,
+                      &cutime, &cstime) == 4)
+        s.own_s = double(utime + stime + cutime + cstime) / tick;
     }
   }
   return s;
@@ -47,5 +50,7 @@ LoadAverage load_average() {
   }
   return l;
 }
+
+nlohmann::json to_json(const LoadAverage& l) { return nlohmann::json::array({l.one, l.five, l.fifteen}); }
 
 }  // namespace pneumo::bench

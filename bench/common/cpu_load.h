@@ -3,10 +3,14 @@
 // Linux /proc; the readings are −1 elsewhere. Used by the Google Benchmark binaries and `pneumo bench`.
 #include <chrono>
 
+#include <nlohmann/json.hpp>
+
 namespace pneumo::bench {
 
 struct CpuSample {
-  double busy_s = -1.0, own_s = -1.0;   // all CPUs' busy time; this process's (all its threads, PoCL's included)
+  // All CPUs' busy time; this process's (all its threads, PoCL's included) and its children's that it has
+  // waited for (`pneumo bench --pipeline` times `pneumo run` as a child).
+  double busy_s = -1.0, own_s = -1.0;
   std::chrono::steady_clock::time_point t = std::chrono::steady_clock::now();
 };
 
@@ -21,5 +25,7 @@ struct LoadAverage {
   double one = -1, five = -1, fifteen = -1;
 };
 LoadAverage load_average();
+/// [1, 5, 15 min] as a JSON array.
+nlohmann::json to_json(const LoadAverage& l);
 
 }  // namespace pneumo::bench

@@ -49,8 +49,6 @@ std::string utc_now() {
   return b;
 }
 
-json load_json(const LoadAverage& l) { return json::array({l.one, l.five, l.fifteen}); }
-
 json machine_json(const BenchContext& ctx) {
   json m;
   m["cpu_model"] = cpu_model();
@@ -104,7 +102,7 @@ json run_bench(const BenchOptions& opt) {
   doc["date_utc"] = utc_now();
   doc["quick"] = opt.quick;
   doc["machine"] = machine_json(ctx);
-  doc["machine"]["load_average_start"] = load_json(load_average());
+  doc["machine"]["load_average_start"] = to_json(load_average());
   const CpuSample c0 = cpu_sample();
 
   // The bandwidth first, for every device, so a reader sees the machine before the stages.
@@ -137,7 +135,7 @@ json run_bench(const BenchOptions& opt) {
   }
   doc["throughput"] = cases;
   doc["bandwidth"] = ctx.bandwidth_json();
-  doc["machine"]["load_average_end"] = load_json(load_average());
+  doc["machine"]["load_average_end"] = to_json(load_average());
   doc["other_cores_mean"] = other_cores(c0, cpu_sample());
   doc["notes"] = ctx.notes();
   doc["wall_time_s"] = seconds_since(t0);

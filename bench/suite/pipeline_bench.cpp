@@ -1,6 +1,5 @@
 #include "suite/pipeline_bench.h"
 
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -29,12 +28,6 @@ using json = nlohmann::json;
 
 // The stages metrics.json times (pipeline/simulate.cpp, run.cpp), in the order they run.
 const char* const kStages[] = {"roles", "mesh", "solve", "warp", "render", "report"};
-
-double children_cpu_s() {
-  rusage u{};
-  if (::getrusage(RUSAGE_CHILDREN, &u) != 0) return -1.0;
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
 
 std::string read_text(const fs::path& p) {
   std::ifstream in(p);
@@ -79,14 +72,10 @@ RunSample run_once(const fs::path& exe, const fs::path& scene, const fs::path& o
   const fs::file_time_type start_file = fs::file_time_type::clock::now();
   const auto t0 = std::chrono::steady_clock::now();
   const CpuSample a = cpu_sample();
-  const double child0 = children_cpu_s();
   const int status = std::system(command.c_str());
-  const double child1 = children_cpu_s();
   const CpuSample b = cpu_sample();
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // Other processes' cores: all CPUs' busy time less the child's own, over the wall time.
-  if (a.busy_s >= 0 && b.busy_s >= 0 && child0 >= 0 && r.wall_s > 0)
-    r.other_cores = std::max(0.0, ((b.busy_s - a.busy_s) - (child1 - child0)) / r.wall_s);
+  r.other_cores = other_cores(a, b);   // the child, waited for, counts as this process's own
   if (status != 0) {
     r.error = "pneumo run exited with status " + std::to_string(status) + ": " + last_line(read_text(log));
     return r;
@@ -150,9 +139,9 @@ json run_pipeline_bench(const PipelineBenchOptions& opt) {
   doc["schema"] = "pneumo-bench-pipeline/1";
   doc["pneumo_version"] = PNEUMO_VERSION;
   doc["quick"] = opt.quick;
+  doc["repetitions"] = reps;
   doc["logical_cpus"] = ::sysconf(_SC_NPROCESSORS_ONLN);
-  const LoadAverage l0 = load_average();
-  doc["load_average_start"] = {l0.one, l0.five, l0.fifteen};
+  doc["load_average_start"] = to_json(load_average());
   doc["anchors"] = json::array(
       {{{"what", "Nimura 2015 (dual Xeon 3.33 GHz)"}, {"seconds", 150.0 * 60.0}},
        {{"what", "Kitasaka 2004 (a Pentium PC)"}, {"seconds", 75.0 * 60.0}}});
@@ -198,8 +187,7 @@ json run_pipeline_bench(const PipelineBenchOptions& opt) {
   }
   fs::remove_all(scratch);
   doc["cases"] = cases;
-  const LoadAverage l1 = load_average();
-  doc["load_average_end"] = {l1.one, l1.five, l1.fifteen};
+  doc["load_average_end"] = to_json(load_average());
   doc["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_all).count();
   if (!opt.json_path.empty()) write_text_file_atomic(opt.json_path, doc.dump(2) + "\n");
   if (!opt.markdown_path.empty()) write_text_file_atomic(opt.markdown_path, pipeline_bench_markdown(doc));
@@ -216,7 +204,7 @@ std::string pipeline_bench_markdown(const json& doc) {
   std::ostringstream md;
   md << "# pneumo bench --pipeline\n\nA CT file to the first laparoscope view, as a user runs it: `pneumo run` as a new "
         "process per row, seconds, median (min–max) over "
-     << (doc.value("quick", false) ? "1 run" : "3 runs") << ". " << doc.value("how", "") << "\n\n";
+     << doc["repetitions"].get<int>() << (doc["repetitions"] == 1 ? " run" : " runs") << ". " << doc.value("how", "") << "\n\n";
   const json& l0 = doc["load_average_start"];
   const json& l1 = doc["load_average_end"];
   char load[160];
