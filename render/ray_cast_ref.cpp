@@ -123,7 +123,6 @@ RenderImage render_reference(const RenderVolume& volume, const ViewCamera& cam, 
           }
           t = hi + 0.5 * s.step_mm;   // the first sample half a step in: a midpoint sum from the entry on
           j = (t - cam.near_mm) / s.step_mm - double(k);
-          t_clear = -1.0;
           if (t > tb) break;
           p = origin_idx + t * didx;
           if (clear_at(p)) {   // a layer thinner than half a step

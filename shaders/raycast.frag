@@ -61,6 +61,31 @@ uint label_at(vec3 idx) {
   return texelFetch(u_labels, v, 0).r;
 }
 
+// One sample at p (model step 2): its label, its volume texel (HU and, packed, the gradient) and its transfer
+// function entry; false when it contributes nothing.
+bool sample_at(vec3 p, out uint id, out vec4 v, out vec4 tf) {
+  id = 0u;
+#if defined(LABELS) || defined(HIDE_EXTERIOR)
+  id = label_at(p);
+#endif
+  v = vec4(0.0);
+  tf = vec4(0.0);
+#ifdef HIDE_EXTERIOR
+  if (id == kExteriorAir) return false;
+#endif
+  v = textureLod(u_vol, (p + 0.5) * u_inv_dims, 0.0);
+  tf = tf_at(v.r * u_hu_scale);
+  return tf.a > 0.0;
+}
+
+// Whether p contributes nothing, with the fetches the entry's bisection needs only.
+bool clear_at(vec3 p) {
+#ifdef HIDE_EXTERIOR
+  if (label_at(p) == kExteriorAir) return true;
+#endif
+  return tf_at(hu_at(p)).a <= 0.0;
+}
+
 float jitter_offset(uint px, uint py, uint seed) {
   uint h = (px * 73856093u) ^ (py * 19349663u) ^ (seed * 83492791u);
   h ^= h >> 16;
@@ -135,46 +160,22 @@ void main() {
     if (t > t_hi) break;
     // The lattice point before t lay in an empty block: as the reference, which samples it, sees it clear.
     if (jumped) t_clear = t - u_step;
-#if defined(LABELS) || defined(HIDE_EXTERIOR)
-    uint id = label_at(p);
-#endif
-#ifdef HIDE_EXTERIOR
-    if (id == kExteriorAir) { t_clear = t; continue; }
-#endif
-    vec3 tex = (p + 0.5) * u_inv_dims;
-    vec4 v = textureLod(u_vol, tex, 0.0);
-    float h = v.r * u_hu_scale;
-    vec4 tf = tf_at(h);
-    if (tf.a <= 0.0) { t_clear = t; continue; }
+    uint id;
+    vec4 v, tf;
+    if (!sample_at(p, id, v, tf)) { t_clear = t; continue; }
     if (t_clear >= 0.0) {
       // Entering matter from clear space (model step 2b): bisect for where the opacity begins and take the
       // first sample half a step past it, so a surface's samples sit where it is, not where the lattice fell.
       float lo = t_clear, hi = t;
       for (int r = 0; r < kEntryBisections; ++r) {
         float mid = 0.5 * (lo + hi);
-        vec3 q = o + mid * d;
-        bool clear = tf_at(hu_at(q)).a <= 0.0;
-#ifdef HIDE_EXTERIOR
-        clear = clear || label_at(q) == kExteriorAir;
-#endif
-        if (clear) lo = mid; else hi = mid;
+        if (clear_at(o + mid * d)) lo = mid; else hi = mid;
       }
       t = hi + 0.5 * u_step;   // the first sample half a step in: a midpoint sum from the entry on
       j = (t - u_near) / u_step - float(k);   // the following samples a step apart from here
-      t_clear = -1.0;
       if (t > t_hi) break;
       p = o + t * d;
-#if defined(LABELS) || defined(HIDE_EXTERIOR)
-      id = label_at(p);
-#endif
-#ifdef HIDE_EXTERIOR
-      if (id == kExteriorAir) { t_clear = t; continue; }
-#endif
-      tex = (p + 0.5) * u_inv_dims;
-      v = textureLod(u_vol, tex, 0.0);
-      h = v.r * u_hu_scale;
-      tf = tf_at(h);
-      if (tf.a <= 0.0) { t_clear = t; continue; }   // a layer thinner than half a step
+      if (!sample_at(p, id, v, tf)) { t_clear = t; continue; }   // a layer thinner than half a step
     }
     t_clear = -1.0;
     float a = tf.a;  // already corrected for the step
@@ -186,7 +187,7 @@ void main() {
 #ifdef PACKED
     vec3 g_idx = v.gba * u_grad_scale;
 #else
-    vec3 g_idx = textureLod(u_grad, tex, 0.0).rgb * u_grad_scale;
+    vec3 g_idx = textureLod(u_grad, (p + 0.5) * u_inv_dims, 0.0).rgb * u_grad_scale;
 #endif
     vec3 g = index_to_world_t * g_idx;
     float glen2 = dot(g, g);
