@@ -5,7 +5,10 @@ import os
 
 
 def merge_patch(target, patch):
-    """RFC 7386: objects merge key by key, null removes a key, anything else replaces."""
+    """RFC 7386: objects merge key by key, null removes a key, anything else replaces. Written here because
+    Debian 12 packages no RFC 7386 library (python3-jsonpatch is RFC 6902, a list of operations), and the
+    whole rule is these lines. Note that a setting's null removes the scene's key, so the run takes pneumo's
+    default; pneumo itself keeps a scene's null as "off" (docs/scene_reference.md)."""
     if not isinstance(patch, dict):
         return patch
     result = dict(target) if isinstance(target, dict) else {}
