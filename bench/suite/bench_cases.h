@@ -28,8 +28,7 @@ struct BenchCase {
 
 /// The phantom of `size` with its scene and Nimura's springs (scene.h use_nimura_springs: the throughput, speed-accuracy
 /// and stability sections measure the springs; the material-model section sets its own); `cube_voxels` > 0 overrides
-/// the scene's L. Logging is quieted while
-/// the phantom's scene names labels its CT lacks.
+/// the scene's L. Logging is quieted while the phantom's scene names labels its CT lacks.
 BenchCase phantom_case(PhantomSize size, int cube_voxels = 0);
 /// Reuses a case's phantom and roles (they do not depend on L) for another cube size.
 void remesh(BenchCase& c, int cube_voxels);

@@ -122,9 +122,16 @@ json run_pipeline_bench(const PipelineBenchOptions& opt) {
   if (!opt.json_path.empty()) check_writable_target(opt.json_path);
   if (!opt.markdown_path.empty()) check_writable_target(opt.markdown_path);
   const fs::path exe = fs::read_symlink("/proc/self/exe");
-  const fs::path scratch = fs::temp_directory_path() / ("pneumo_pipeline_bench_" + std::to_string(::getpid()));
-  fs::remove_all(scratch);
-  fs::create_directories(scratch);
+  // The phantoms' files and the runs' folders (up to a few GB for the large phantom), removed however this ends.
+  struct Scratch {
+    fs::path path = fs::temp_directory_path() / ("pneumo_pipeline_bench_" + std::to_string(::getpid()));
+    Scratch() { fs::remove_all(path), fs::create_directories(path); }
+    ~Scratch() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  } scratch_dir;
+  const fs::path& scratch = scratch_dir.path;
 
   const std::vector<PhantomSize> sizes =
       opt.quick ? std::vector<PhantomSize>{PhantomSize::Small} : std::vector<PhantomSize>{PhantomSize::Medium, PhantomSize::Large};
@@ -185,7 +192,6 @@ json run_pipeline_bench(const PipelineBenchOptions& opt) {
     cases.push_back(c);
     fs::remove_all(dir);
   }
-  fs::remove_all(scratch);
   doc["cases"] = cases;
   doc["load_average_end"] = to_json(load_average());
   doc["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_all).count();
