@@ -13,6 +13,7 @@
 #include <set>
 
 #include "cli_test_support.h"
+#include "grid_test_support.h"
 #include "core/error.h"
 #include "core/progress.h"
 #include "io/volume_io.h"
@@ -114,8 +115,9 @@ TEST_F(WarpPipeline, ThePhantomAt12MmHgOpensAGasCavityBetweenWallAndViscera) {
     EXPECT_TRUE(fs::exists(path(std::string("sim/") + f))) << f;
   const Volume ct_in = read_volume(path("case/ct.nii.gz")), lab_in = read_volume(path("case/labels.nii.gz"));
   const Volume ct = read_volume(path("sim/deformed_ct.nii.gz")), lab = read_volume(path("sim/deformed_labels.nii.gz"));
-  EXPECT_TRUE(ct.geometry().same_grid(ct_in.geometry()));
-  EXPECT_TRUE(lab.geometry().same_grid(ct_in.geometry()));
+  testing_support::expect_holds_grid(ct.geometry(), ct_in.geometry(), "deformed CT");
+  testing_support::expect_holds_grid(lab.geometry(), ct_in.geometry(), "deformed labels");
+  EXPECT_TRUE(ct.geometry().same_grid(lab.geometry()));
   EXPECT_EQ(ct.type(), ct_in.type());
   EXPECT_EQ(lab.type(), lab_in.type());
   EXPECT_NE(warp_.out.find("cavity"), std::string::npos) << warp_.out;
@@ -173,7 +175,8 @@ TEST_F(WarpPipeline, ThePhantomAt12MmHgOpensAGasCavityBetweenWallAndViscera) {
     const WarpedCase dev = warp_scene(on, path("sim"));
     // As in test_warp_cl_vs_ref.cpp: CT within 0.1 HU where both carry a voxel, outcome and label
     // exactly equal except at measured ties.
-    const Index3 dims = cpu.ct.geometry().dims, lo = cpu.roles.pad.lo;
+    ASSERT_EQ(dev.output_grid.dims, cpu.output_grid.dims) << spec;
+    const Index3 dims = cpu.output_grid.dims, lo = cpu.box.lo;
     int64_t ties = 0, untied = 0;
     double worst = 0.0;
     for (int64_t k = 0; k < dims[2]; ++k)
@@ -311,12 +314,17 @@ TEST_F(WarpPipeline, ZeroDeformationWritesTheInputBackBitForBit) {
       }
   EXPECT_EQ(wrong, 0);
 
-  // Moved 1 m to the right, the body leaves any grid: reported by at least the grid's own width.
+  // Moved 1 m to the right, the body leaves any grid: the grid grows by the cap, no more, and the
+  // rest is reported (at least 1 m less the grid's width and the cap).
   Deformation away = zero;
   for (Vec3& u : away.displacement_m) u = Vec3(1.0, 0.0, 0.0);
   ScratchDir moved;
   write_deformation(moved.file("deformation.bin"), mesh, away);
   std::ofstream(moved.file("metrics.json")) << "{}";
   const WarpedCase m = warp_scene(scene, moved.path().string());
-  EXPECT_GT(m.outside_grid_mm, 1000.0 - double(roles.geometry.dims[0]) * roles.geometry.spacing_mm[0]);
+  const double width_mm = double(roles.geometry.dims[0]) * roles.geometry.spacing_mm[0];
+  EXPECT_GT(m.outside_grid_mm, 1000.0 - width_mm - kMaxGridGrowthMm);
+  EXPECT_LE(double(m.output_grid.dims[0]) * m.output_grid.spacing_mm[0], width_mm + kMaxGridGrowthMm);
+  EXPECT_GT(double(m.output_grid.dims[0] + m.warp_mesh.cube_voxels) * m.output_grid.spacing_mm[0],
+            width_mm + kMaxGridGrowthMm);   // the cap, less under a cube on a low-index side
 }

@@ -79,6 +79,26 @@ void fill_rounded(Volume& v, const std::vector<float>& hu) {
   }
 }
 
+/// Grows the working grid (roles and warp mesh together) wherever the deformed body leaves it, by
+/// air: the deformed CT then holds the whole body, and a dome that rises out of the CT and its
+/// padding is not clipped (issue "A human answer", item 5).
+void grow_to_hold_the_deformed_body(WarpedCase& w) {
+  const Vec3& s = w.roles.geometry.spacing_mm;
+  const Index3 cap{int64_t(kMaxGridGrowthMm / s[0]), int64_t(kMaxGridGrowthMm / s[1]),
+                   int64_t(kMaxGridGrowthMm / s[2])};
+  const PadVoxels grow = growth_to_hold_deformed(w.warp_mesh, cap);
+  if (grow.empty()) return;
+  w.roles = grown_roles(std::move(w.roles), grow);
+  w.warp_mesh = grown_warp_mesh(w.warp_mesh, grow);
+  char msg[200];
+  std::snprintf(msg, sizeof msg,
+                "warp: the deformed body leaves the working grid; grown by voxels i %lld/%lld, j %lld/%lld, "
+                "k %lld/%lld (low/high end)",
+                (long long)grow.lo[0], (long long)grow.hi[0], (long long)grow.lo[1], (long long)grow.hi[1],
+                (long long)grow.lo[2], (long long)grow.hi[2]);
+  log::info(msg);
+}
+
 }  // namespace
 
 DeformedMesh load_deformed_mesh(const Scene& scene, const std::string& sim_dir) {
@@ -130,13 +150,14 @@ WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labe
   if (w.labels) check_cavity_label_free(scene, w.roles);
   const uint16_t cavity = uint16_t(scene.output.cavity_label);
   w.warp_mesh = make_warp_mesh(w.mesh, w.deformation.displacement_m);
+  const bool working = scene.output.grid == OutputGrid::Working;
+  if (working) grow_to_hold_the_deformed_body(w);
 
   WarpSource src;
   src.ct_hu = w.roles.ct.data<float>();
   src.labels = w.labels ? w.roles.label.data() : nullptr;
   src.roles = w.roles.role.data();
-  // The working grid holds the mesh, so the deformed body too unless it rises beyond the padding.
-  const bool working = scene.output.grid == OutputGrid::Working;
+  // The working grid holds the mesh and, grown, the deformed body.
   w.output_grid = working ? w.roles.geometry : w.ct.geometry();
   WarpBox& box = w.box;
   box.lo = working ? Index3{0, 0, 0} : w.roles.pad.lo;

@@ -21,16 +21,21 @@
 
 namespace pneumo {
 
+/// The farthest the output grid grows past the working grid on any side to hold the deformed body
+/// (mm). Patients' wall rises by centimetres; a node farther out comes from a diverged solve, whose
+/// grid must not grow to gigabytes: what lies beyond is clipped and reported (outside_grid_mm).
+constexpr double kMaxGridGrowthMm = 150.0;
+
 struct WarpedCase {
   Volume ct;                      // the input CT as read (its grid and type are the outputs')
   std::optional<Volume> labels;   // the input label map, when the scene gives one
-  RoleVolume roles;               // on the working (padded) grid
+  RoleVolume roles;               // on the working (padded) grid, grown to hold the deformed body
   Mesh mesh;
   Deformation deformation;
   WarpMesh warp_mesh;
   WarpResult result;              // on output_grid
   WarpBox box;                    // output_grid within the working grid
-  Geometry output_grid;           // output.grid: the working grid or the CT's
+  Geometry output_grid;           // output.grid: the working grid (grown to hold the body) or the CT's
   double outside_grid_mm = 0.0;   // how far the deformed mesh reaches beyond output_grid (0: inside)
   double voxel_volume_ml = 0.0;
   std::optional<Vec3> cavity_centroid_mm;   // none when no voxel became gas

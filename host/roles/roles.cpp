@@ -59,6 +59,21 @@ double RoleVolume::voxel_volume_ml() const {
   return geometry.spacing_mm[0] * geometry.spacing_mm[1] * geometry.spacing_mm[2] / 1000.0;
 }
 
+RoleVolume grown_roles(RoleVolume rv, const PadVoxels& grow) {
+  if (grow.empty()) return rv;
+  const Index3 dims = rv.geometry.dims;
+  RoleVolume g;
+  g.geometry = padded_geometry(rv.geometry, grow);
+  for (int a = 0; a < 3; ++a) {
+    g.pad.lo[a] = rv.pad.lo[a] + grow.lo[a];
+    g.pad.hi[a] = rv.pad.hi[a] + grow.hi[a];
+  }
+  g.role = pad_array<Role>(rv.role.data(), dims, grow, Role::Other);
+  g.label = pad_array<uint16_t>(rv.label.data(), dims, grow, uint16_t(0));
+  g.ct = padded_ct_float(rv.ct, grow);
+  return g;
+}
+
 void require_labels_if_needed(const RoleRules& rules, bool have_labels, const RoleInputNames& names) {
   if (rules.source == RoleSource::Labels && !have_labels)
     throw InputError(names.scene +

@@ -32,6 +32,10 @@ struct RoleVolume {
   double volume_ml(Role r) const { return double(count(r)) * voxel_volume_ml(); }
 };
 
+/// `rv` on its grid grown by `grow` (padded_geometry), as the padding is filled: −1000 HU, label 0,
+/// role other; rv.pad grows with it, so the CT's grid stays where it was inside the working grid.
+RoleVolume grown_roles(RoleVolume rv, const PadVoxels& grow);
+
 /// What messages call the inputs: the scene file and the CT's and label map's files.
 struct RoleInputNames {
   std::string scene = "scene", ct = "(CT)", labels = "(label map)";

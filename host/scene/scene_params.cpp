@@ -416,8 +416,9 @@ const Table<SceneOutput>& output_table() {
        "ITK's DisplacementFieldTransform, ANTs and 3D Slicer apply it to another image; zero in the cavity. "
        "The same field as an ITK transform file, displacement_field_transform.h5, beside it."},
       {"grid", &SceneOutput::grid, "", any(),
-       "Grid of deformed_ct and deformed_labels: \"working\" = the CT grown by roles.pad_* (same spacing and "
-       "direction; it holds the mesh, so a dome that rises out of the CT is not clipped), \"input\" = the CT's own."},
+       "Grid of deformed_ct and deformed_labels: \"working\" = the CT grown by roles.pad_* and, where the "
+       "deformed body leaves that, by air out to it (same spacing and direction; whole cubes on the low-index "
+       "sides, at most 150 mm), so a dome that rises out of the CT is not clipped; \"input\" = the CT's own."},
       {"cavity_label", &SceneOutput::cavity_label, "", in(1, 65535),
        "Label id of the CO2 cavity in the warped label map (§7); must not be an id the label map uses."},
       {"min_cavity_piece_ml", &SceneOutput::min_cavity_piece_ml, "ml", in(0, 1e6),

@@ -1,6 +1,8 @@
 #include "warp/warp_mesh.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "core/units.h"
@@ -53,6 +55,52 @@ void check_warp_mesh(const WarpMesh& m) {
       fail("the rest-space table has " + std::to_string(m.cubes[a]) + " cubes on axis " + std::to_string(a) +
            ", fewer than the grid's " + std::to_string(m.grid.dims[a]) + " voxels need");
   if (int64_t(m.cube_meshed.size()) != m.cubes[0] * m.cubes[1] * m.cubes[2]) fail("cube_meshed size");
+}
+
+PadVoxels growth_to_hold_deformed(const WarpMesh& m, const Index3& max_voxels) {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (std::size_t n = 0; n < m.rest_ijk.size(); ++n) {
+    const Vec3 x = m.rest_ijk[n] + m.disp_ijk[n];
+    if (!x.allFinite()) continue;
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  PadVoxels grow;
+  if (!(hi.x() >= lo.x())) return grow;   // no finite node
+  const int64_t L = std::max(1, m.cube_voxels);
+  for (int a = 0; a < 3; ++a) {
+    // Voxel cells 0 … n−1 cover [−½, n−½): a rest node on the grid's face needs nothing, a node
+    // beyond it the cells out to its place.
+    const double below = -lo[a] - 0.5, above = hi[a] + 0.5 - double(m.grid.dims[a]);
+    const int64_t cap = std::max<int64_t>(0, max_voxels[a]);
+    if (below > 0) grow.lo[a] = std::min((int64_t(std::ceil(below)) + L - 1) / L * L, cap / L * L);
+    if (above > 0) grow.hi[a] = std::min(int64_t(std::ceil(above)), cap);
+  }
+  return grow;
+}
+
+WarpMesh grown_warp_mesh(const WarpMesh& m, const PadVoxels& grow) {
+  const int64_t L = m.cube_voxels;
+  for (int a = 0; a < 3; ++a)
+    if (grow.lo[a] < 0 || grow.hi[a] < 0 || L < 1 || grow.lo[a] % L != 0)
+      throw std::invalid_argument("grown_warp_mesh: the low ends must grow by whole cubes of " + std::to_string(L) +
+                                  " voxels and no end may shrink");
+  WarpMesh g = m;
+  g.grid = padded_geometry(m.grid, grow);
+  const Vec3 shift(double(grow.lo[0]), double(grow.lo[1]), double(grow.lo[2]));
+  for (Vec3& x : g.rest_ijk) x += shift;   // displacements are differences: unchanged
+  Index3 offset{0, 0, 0};
+  for (int a = 0; a < 3; ++a) {
+    offset[a] = grow.lo[a] / L;
+    g.cubes[a] = std::max(m.cubes[a] + offset[a], (g.grid.dims[a] + L - 1) / L);
+  }
+  g.cube_meshed.assign(std::size_t(g.cubes[0] * g.cubes[1] * g.cubes[2]), 0);
+  for (int64_t c = 0; c < m.cubes[2]; ++c)
+    for (int64_t b = 0; b < m.cubes[1]; ++b)
+      for (int64_t a = 0; a < m.cubes[0]; ++a)
+        g.cube_meshed[std::size_t((a + offset[0]) + g.cubes[0] * ((b + offset[1]) + g.cubes[1] * (c + offset[2])))] =
+            m.cube_meshed[std::size_t(a + m.cubes[0] * (b + m.cubes[1] * c))];
+  return g;
 }
 
 bool warp_tet_degenerate(const WarpMesh& m, int64_t tet) {

@@ -18,6 +18,7 @@
 
 #include "core/geometry.h"
 #include "mesh/mesh.h"
+#include "roles/pad.h"
 
 namespace pneumo {
 
@@ -47,6 +48,19 @@ void check_warp_mesh(const WarpMesh& m);
 /// The warp mesh of `mesh` displaced by `displacement_m` (metres, one per node, world RAS+).
 /// std::invalid_argument when the sizes differ.
 WarpMesh make_warp_mesh(const Mesh& mesh, const std::vector<Vec3>& displacement_m);
+
+/// How much to grow m.grid so that every deformed node lies in one of its voxels' cells: the output
+/// grid of a body that moved out of the CT (issue "A human answer", item 5). Whole cubes at the low
+/// ends, so that cube a keeps its place [aL − ½, (a+1)L − ½) in the lattice after the shift; single
+/// voxels at the high ends; nothing on a side the nodes stay inside. No end grows by more than
+/// `max_voxels` on its axis (rounded down to whole cubes at the low ends): a node flung far by a
+/// diverged solve must not ask for gigabytes. Non-finite positions are skipped.
+PadVoxels growth_to_hold_deformed(const WarpMesh& m, const Index3& max_voxels);
+
+/// `m` on its grid grown by `grow` (padded_geometry): index coordinates shifted by grow.lo and the
+/// rest-space table re-indexed, so the warp of the grown roles equals the warp of the original on
+/// their common voxels. std::invalid_argument unless grow.lo is whole cubes and no end shrinks.
+WarpMesh grown_warp_mesh(const WarpMesh& m, const PadVoxels& grow);
 
 /// A deformed tetrahedron too flat to invert (|det| of its edge matrix below 1e-9 of its edge
 /// length cubed): it covers no voxel centre in a way that could be sampled. Both the reference and
