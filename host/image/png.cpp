@@ -89,14 +89,23 @@ std::string encode_gray16(const std::string& path, int w, int h, const std::vect
 
 }  // namespace
 
+namespace {
+std::string encode_png_rgb(const std::string& what, int w, int h, const std::vector<uint8_t>& rgb) {
+  check_size(what, w, h, rgb.size(), 3);
+  std::string bytes;
+  if (!stbi_write_png_to_func(append_to_string, &bytes, w, h, 3, rgb.data(), w * 3))
+    throw std::runtime_error(what + ": stb_image_write failed to encode the PNG");
+  return bytes;
+}
+}  // namespace
+
 void write_png_rgb(const std::string& path, int w, int h, const std::vector<uint8_t>& rgb) {
   check_size(path, w, h, rgb.size(), 3);
   check_writable_target(path);
-  std::string bytes;
-  if (!stbi_write_png_to_func(append_to_string, &bytes, w, h, 3, rgb.data(), w * 3))
-    throw std::runtime_error(path + ": stb_image_write failed to encode the PNG");
-  write_bytes_atomic(path, bytes);
+  write_bytes_atomic(path, encode_png_rgb(path, w, h, rgb));
 }
+
+std::string encode_png(const RgbImage& image) { return encode_png_rgb("PNG", image.width, image.height, image.rgb); }
 
 void write_jpeg(const std::string& path, const RgbImage& image, int quality) {
   check_size(path, image.width, image.height, image.rgb.size(), 3);

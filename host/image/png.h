@@ -15,6 +15,9 @@ namespace pneumo {
 /// when the sizes do not match.
 void write_png_rgb(const std::string& path, int w, int h, const std::vector<uint8_t>& rgb);
 void write_png(const std::string& path, const RgbImage& image);
+/// The PNG's bytes in memory (what `pneumo serve` answers a view with); std::invalid_argument when
+/// the sizes do not match, std::runtime_error when the encoding fails.
+std::string encode_png(const RgbImage& image);
 /// Baseline JPEG at `quality` 1-100 (the report's fly-through strip: photographic frames, a tenth
 /// of the PNG's bytes); the same checks and atomic write as the PNGs.
 void write_jpeg(const std::string& path, const RgbImage& image, int quality);
