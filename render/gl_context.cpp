@@ -197,6 +197,11 @@ struct GlContext::Impl {
     }
   }
 
+  void release_current() {
+    if (context != EGL_NO_CONTEXT) egl.MakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    // OSMesa binds a context per thread and lets another thread bind it: nothing to release.
+  }
+
   ~Impl() {
     if (context != EGL_NO_CONTEXT) {
       egl.MakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
@@ -267,6 +272,7 @@ GlContext::GlContext(GlBackend backend) : impl_(std::make_unique<Impl>()) {
 GlContext::~GlContext() = default;
 
 void GlContext::make_current() { impl_->make_current(); }
+void GlContext::release_current() { impl_->release_current(); }
 
 GlContext& shared_gl_context(GlBackend backend) {
   static std::mutex m;

@@ -37,6 +37,10 @@ class GlContext {
   const GlContextInfo& info() const { return info_; }
   /// Makes this context current on the calling thread (again).
   void make_current();
+  /// Releases it from the calling thread, so that another may make it current (EGL refuses a
+  /// context still current on a thread, even one that has ended). A thread that rendered and is about
+  /// to end calls this (`pneumo serve`'s worker).
+  void release_current();
 
   struct Impl;
 
