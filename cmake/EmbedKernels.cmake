@@ -1,30 +1,35 @@
-# Embeds every kernels/*.cl file into the library as a string, keyed by its path below kernels/
-# (e.g. "common/math.cl"), so no path is needed at run time. The generated file is rebuilt
-# whenever a kernel changes.
-function(pneumo_embed_kernels out_cpp kernel_root)
+# Embeds source files into the library as strings, keyed by their path below a root folder, so no
+# path is needed at run time: the OpenCL kernels (kernels/*.cl, e.g. "common/math.cl"), the GLSL
+# shaders (shaders/*) and the page of `pneumo serve` (host/serve/page/*). The generated file is
+# rebuilt whenever one of them changes; cmake/EmbedKernelsScript.cmake writes it.
+#
+#   pneumo_embed(OUT_CPP ROOT HEADER NAMESPACE TYPE FUNC COMMENT SOURCES...)
+#     a table `const std::vector<TYPE>& NAMESPACE::FUNC()` declared in HEADER
+function(pneumo_embed out_cpp root header namespace type func comment)
   set(sources ${ARGN})
   # Passed as one argument: a list joined by "|" (a ";" would split the command line).
   string(REPLACE ";" "|" joined "${sources}")
   add_custom_command(
     OUTPUT ${out_cpp}
-    COMMAND ${CMAKE_COMMAND} -DOUT=${out_cpp} -DROOT=${kernel_root} "-DSOURCES=${joined}"
+    COMMAND ${CMAKE_COMMAND} -DOUT=${out_cpp} -DROOT=${root} "-DSOURCES=${joined}"
+            -DHEADER=${header} -DNAMESPACE=${namespace} -DTYPE=${type} -DFUNC=${func}
             -P ${CMAKE_CURRENT_SOURCE_DIR}/cmake/EmbedKernelsScript.cmake
     DEPENDS ${sources} ${CMAKE_CURRENT_SOURCE_DIR}/cmake/EmbedKernelsScript.cmake
-    COMMENT "Embedding OpenCL kernels"
+    COMMENT "${comment}"
     VERBATIM)
 endfunction()
 
-# The same for GLSL shaders (shaders/*.vert, *.frag): table pneumo::gl::embedded_shaders().
+function(pneumo_embed_kernels out_cpp kernel_root)
+  pneumo_embed(${out_cpp} ${kernel_root} cl/embedded_kernels.h pneumo::ocl EmbeddedKernel embedded_kernels
+               "Embedding OpenCL kernels" ${ARGN})
+endfunction()
+
 function(pneumo_embed_shaders out_cpp shader_root)
-  set(sources ${ARGN})
-  string(REPLACE ";" "|" joined "${sources}")
-  add_custom_command(
-    OUTPUT ${out_cpp}
-    COMMAND ${CMAKE_COMMAND} -DOUT=${out_cpp} -DROOT=${shader_root} "-DSOURCES=${joined}"
-            -DHEADER=render/embedded_shaders.h -DNAMESPACE=pneumo::gl -DTYPE=EmbeddedShader
-            -DFUNC=embedded_shaders
-            -P ${CMAKE_CURRENT_SOURCE_DIR}/cmake/EmbedKernelsScript.cmake
-    DEPENDS ${sources} ${CMAKE_CURRENT_SOURCE_DIR}/cmake/EmbedKernelsScript.cmake
-    COMMENT "Embedding GLSL shaders"
-    VERBATIM)
+  pneumo_embed(${out_cpp} ${shader_root} render/embedded_shaders.h pneumo::gl EmbeddedShader embedded_shaders
+               "Embedding GLSL shaders" ${ARGN})
+endfunction()
+
+function(pneumo_embed_page out_cpp page_root)
+  pneumo_embed(${out_cpp} ${page_root} serve/embedded_page.h pneumo::serve EmbeddedPageFile embedded_page
+               "Embedding the serve page" ${ARGN})
 endfunction()

@@ -20,6 +20,8 @@ packages=(
   libnifti2-dev zlib1g-dev libhdf5-dev libgdcm-dev libteem-dev
   # CLI and scenes
   libcli11-dev nlohmann-json3-dev
+  # `pneumo serve`: cpp-httplib serves the page; the browser test drives Chromium through Selenium
+  libcpp-httplib-dev chromium-driver python3-selenium
   # tests and benchmarks; VTK's Python reader checks the meshes pneumo writes (tests/test_vtu_vtk.cpp),
   # ITK applies the displacement field pneumo writes and nibabel reads it (tests/test_displacement_field.cpp),
   # pydicom writes the DICOM series pneumo reads (tests/test_dicom_series.cpp)

@@ -20,5 +20,6 @@ Run add_render(CLI::App& app);
 Run add_run(CLI::App& app);
 Run add_warp(CLI::App& app);
 Run add_bench(CLI::App& app);
+Run add_serve(CLI::App& app);
 
 }  // namespace pneumo::cli

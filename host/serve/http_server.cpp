@@ -1,0 +1,378 @@
+#include "serve/http_server.h"
+
+#include <httplib.h>
+// glibc's <resolv.h>, which cpp-httplib includes, defines the macro _res, a parameter name in Eigen's
+// templates: it must not reach the headers below.
+#undef _res
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "render/gl_context.h"
+#include "scene/scene.h"
+#include "serve/embedded_page.h"
+#include "serve/planning_session.h"
+#include "serve/serial_worker.h"
+
+extern char** environ;
+
+namespace pneumo::serve {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+nlohmann::json read_scene_json(const std::string& path) {
+  std::ifstream is(path);
+  if (!is) throw InputError(path + ": cannot read the scene");
+  try {
+    return nlohmann::json::parse(is);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path + ": not valid JSON (" + e.what() + ")");
+  }
+}
+
+const char* content_type(const std::string& path) {
+  if (path.size() >= 5 && path.compare(path.size() - 5, 5, ".html") == 0) return "text/html; charset=utf-8";
+  if (path.size() >= 3 && path.compare(path.size() - 3, 3, ".js") == 0) return "text/javascript; charset=utf-8";
+  if (path.size() >= 4 && path.compare(path.size() - 4, 4, ".css") == 0) return "text/css; charset=utf-8";
+  return "application/octet-stream";
+}
+
+double number(const httplib::Request& q, const char* key, double fallback) {
+  if (!q.has_param(key)) return fallback;
+  const std::string v = q.get_param_value(key);
+  char* end = nullptr;
+  const double d = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end != '\0' || !std::isfinite(d)) throw InputError(std::string(key) + ": not a number: " + v);
+  return d;
+}
+
+Vec3 vec3_of(const nlohmann::json& j, const std::string& what) {
+  if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number())
+    throw InputError(what + ": three numbers expected");
+  const Vec3 v(j[0].get<double>(), j[1].get<double>(), j[2].get<double>());
+  if (!v.allFinite()) throw InputError(what + ": not finite");
+  return v;
+}
+
+ScopeRequest scope_request(const httplib::Request& q) {
+  ScopeRequest s;
+  s.skin_point_mm = Vec3(number(q, "sx", NAN), number(q, "sy", NAN), number(q, "sz", NAN));
+  if (!s.skin_point_mm.allFinite()) throw InputError("sx, sy, sz (the port's skin point, mm) are required");
+  if (q.has_param("label")) s.target_label = int(number(q, "label", 0));
+  else s.target_mm = Vec3(number(q, "tx", NAN), number(q, "ty", NAN), number(q, "tz", NAN));
+  if (s.target_mm && !s.target_mm->allFinite()) throw InputError("label or tx, ty, tz (the target) are required");
+  s.insertion_mm = number(q, "ins", s.insertion_mm);
+  s.fov_deg = number(q, "fov", s.fov_deg);
+  s.oblique_deg = number(q, "obl", s.oblique_deg);
+  s.roll_deg = number(q, "roll", s.roll_deg);
+  s.yaw_deg = number(q, "yaw", 0.0);
+  s.pitch_deg = number(q, "pitch", 0.0);
+  s.width = int(number(q, "w", s.width));
+  s.height = int(number(q, "h", s.height));
+  return s;
+}
+
+/// A request's JSON body (objects only).
+nlohmann::json body_json(const httplib::Request& q) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(q.body.empty() ? "{}" : q.body);
+  } catch (const nlohmann::json::exception&) {
+    throw InputError("the body is not valid JSON");
+  }
+  if (!j.is_object()) throw InputError("the body must be a JSON object");
+  return j;
+}
+
+void answer_json(httplib::Response& res, const nlohmann::json& j, int status = 200) {
+  res.status = status;
+  res.set_content(j.dump(), "application/json");
+}
+
+/// Requests a second over the whole server, counted in one-second windows.
+class RateLimit {
+ public:
+  int per_second = kMaxRequestsPerSecond;
+  bool allow() {
+    const int64_t now = std::chrono::duration_cast<std::chrono::seconds>(
+                            std::chrono::steady_clock::now().time_since_epoch()).count();
+    std::lock_guard<std::mutex> lock(m_);
+    if (now != window_) {
+      window_ = now;
+      count_ = 0;
+    }
+    return ++count_ <= per_second;
+  }
+
+ private:
+  std::mutex m_;
+  int64_t window_ = 0;
+  int count_ = 0;
+};
+
+}  // namespace
+
+struct Server::Impl {
+  ServeOptions opt;
+  std::unique_ptr<PlanningSession> session;   // built and used on the worker's thread only
+  std::unique_ptr<SerialWorker> worker;
+  httplib::Server http;
+  RateLimit rate;
+  std::mutex plan_mutex;
+  pid_t plan_pid = -1;
+  std::thread plan_waiter;
+  nlohmann::json plan_status = {{"state", "none"}};
+
+  template <class F>
+  auto on_worker(F f) {
+    return worker->run(std::move(f)).get();
+  }
+
+  void start_plan(const nlohmann::json& body);
+  void routes();
+};
+
+Server::Server(ServeOptions options) : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.opt = std::move(options);
+  if (s.opt.self_exe.empty()) s.opt.self_exe = fs::read_symlink("/proc/self/exe").string();
+  nlohmann::json scene_json = read_scene_json(s.opt.scene_path);
+  parse_scene(scene_json, s.opt.scene_path);   // a bad scene is refused before any thread starts
+  s.worker = std::make_unique<SerialWorker>(
+      [&s](const std::string& message) {
+        log::warn("serve: " + message);
+        if (s.session) s.session->set_error(message);
+      },
+      [&s] {
+        // The case's GL objects go on the thread that made them, and the process's context is
+        // released from it, so that a later worker (a second server in one process) can render.
+        const bool rendered = s.session != nullptr;
+        s.session.reset();
+        if (rendered) shared_gl_context(s.opt.backend).release_current();
+      });
+  // Built on the worker: the GL context becomes current on the thread that renders with it.
+  s.on_worker([&] {
+    s.session = std::make_unique<PlanningSession>(scene_json, s.opt.scene_path, s.opt.backend);
+    return 0;
+  });
+  s.worker->start([&s](SerialWorker& w, uint64_t g) { s.session->inflate(InflateRequest{}, w, g); });
+  s.routes();
+}
+
+Server::~Server() {
+  stop();
+  impl_->worker->stop();
+  {
+    std::lock_guard<std::mutex> lock(impl_->plan_mutex);
+    if (impl_->plan_pid > 0) ::kill(impl_->plan_pid, SIGTERM);   // a plan's run ends with the server
+  }
+  if (impl_->plan_waiter.joinable()) impl_->plan_waiter.join();
+}
+
+int Server::bind() {
+  Impl& s = *impl_;
+  if (s.opt.host != "127.0.0.1" && s.opt.host != "localhost" && s.opt.host != "::1")
+    log::warn("serve: listening on " + s.opt.host +
+              ": anyone who can reach this address can see the case and drive the solver; there is no login");
+  if (s.opt.port == 0) {
+    const int port = s.http.bind_to_any_port(s.opt.host);
+    if (port < 0) throw std::runtime_error("serve: cannot bind " + s.opt.host);
+    return port;
+  }
+  if (!s.http.bind_to_port(s.opt.host, s.opt.port))
+    throw std::runtime_error("serve: cannot bind " + s.opt.host + ":" + std::to_string(s.opt.port) +
+                             " (in use? choose another with --port)");
+  return s.opt.port;
+}
+
+void Server::listen() { impl_->http.listen_after_bind(); }
+void Server::stop() { impl_->http.stop(); }
+
+void Server::Impl::start_plan(const nlohmann::json& body) {
+  if (!body.contains("ports") || !body["ports"].is_array() || body["ports"].size() > 16)
+    throw InputError("plan: \"ports\" must be a list of at most 16 ports");
+  std::vector<std::pair<std::string, ScopeRequest>> ports;
+  for (const nlohmann::json& p : body["ports"]) {
+    if (!p.is_object()) throw InputError("plan: each port is an object");
+    ScopeRequest q;
+    q.skin_point_mm = vec3_of(p.value("skin_point_mm", nlohmann::json()), "skin_point_mm");
+    if (p.contains("target_label") && p["target_label"].is_number_integer()) q.target_label = p["target_label"].get<int>();
+    else q.target_mm = vec3_of(p.value("target_mm", nlohmann::json()), "target_mm");
+    q.insertion_mm = p.value("insertion_mm", q.insertion_mm);
+    q.fov_deg = p.value("fov_deg", q.fov_deg);
+    q.oblique_deg = p.value("oblique_deg", q.oblique_deg);
+    q.roll_deg = p.value("roll_deg", q.roll_deg);
+    ports.emplace_back("port_" + std::to_string(ports.size() + 1), q);
+  }
+  nlohmann::json plan = on_worker([&] { return session->plan_json(ports); });
+  // The inputs by absolute path: the plan lives in another folder than the scene.
+  const Scene scene = parse_scene(plan, opt.scene_path);
+  plan["inputs"]["ct"] = fs::absolute(scene.inputs.ct).string();
+  if (!scene.inputs.labels.empty()) plan["inputs"]["labels"] = fs::absolute(scene.inputs.labels).string();
+  if (!scene.inputs.label_names.empty()) plan["inputs"]["label_names"] = fs::absolute(scene.inputs.label_names).string();
+  const fs::path out(opt.out_dir);
+  fs::create_directories(out);
+  const std::string plan_path = (out / "plan.json").string();
+  parse_scene(plan, plan_path);   // every port checked as a scene's, before anything runs
+  std::lock_guard<std::mutex> lock(plan_mutex);
+  if (plan_pid > 0) throw InputError("plan: a plan's run is still going; wait for it");
+  write_text_file_atomic(plan_path, plan.dump(2) + "\n");
+  const std::string report_dir = (out / "plan").string();
+  std::vector<std::string> args = {opt.self_exe, "-q", "run", plan_path, "--out", report_dir, "--force"};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  if (posix_spawn(&pid, opt.self_exe.c_str(), nullptr, nullptr, argv.data(), environ) != 0)
+    throw std::runtime_error("plan: cannot start " + opt.self_exe);
+  plan_pid = pid;
+  plan_status = {{"state", "running"}, {"scene", plan_path}, {"out", report_dir}};
+  if (plan_waiter.joinable()) plan_waiter.join();
+  plan_waiter = std::thread([this, pid] {
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    std::lock_guard<std::mutex> l(plan_mutex);
+    plan_pid = -1;
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    plan_status["state"] = code == 0 ? "done" : "failed";
+    plan_status["exit_code"] = code;
+  });
+}
+
+void Server::Impl::routes() {
+  rate.per_second = opt.requests_per_second;
+  http.new_task_queue = [] { return new httplib::ThreadPool(4); };
+  http.set_payload_max_length(kMaxBodyBytes);
+  http.set_pre_routing_handler([this](const httplib::Request&, httplib::Response& res) {
+    if (rate.allow()) return httplib::Server::HandlerResponse::Unhandled;
+    answer_json(res, {{"error", "too many requests"}}, 429);
+    return httplib::Server::HandlerResponse::Handled;
+  });
+  http.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
+    try {
+      std::rethrow_exception(ep);
+    } catch (const InputError& e) {
+      answer_json(res, {{"error", e.what()}}, 400);
+    } catch (const nlohmann::json::exception& e) {   // a field of the wrong type
+      answer_json(res, {{"error", std::string("bad request: ") + e.what()}}, 400);
+    } catch (const SerialWorker::Busy& e) {
+      answer_json(res, {{"error", e.what()}}, 503);
+    } catch (const std::exception& e) {
+      answer_json(res, {{"error", e.what()}}, 500);
+    }
+  });
+
+  for (const EmbeddedPageFile& f : embedded_page()) {
+    const std::string route = std::string("/") + (std::string(f.path) == "index.html" ? "" : f.path);
+    const std::string* text = &f.source;
+    const char* type = content_type(f.path);
+    http.Get(route, [text, type](const httplib::Request&, httplib::Response& res) { res.set_content(*text, type); });
+  }
+
+  http.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
+    nlohmann::json j = session->status();
+    {
+      std::lock_guard<std::mutex> lock(plan_mutex);
+      j["plan"] = plan_status;
+    }
+    j["generation_latest"] = worker->generation();
+    answer_json(res, j);
+  });
+  http.Post("/api/inflate", [this](const httplib::Request& q, httplib::Response& res) {
+    const nlohmann::json b = body_json(q);
+    InflateRequest r;
+    if (b.contains("pressure_mmhg")) r.pressure_mmhg = b["pressure_mmhg"].get<double>();
+    if (b.contains("wall_young_kpa")) r.wall_young_kpa = b["wall_young_kpa"].get<double>();
+    if (b.contains("preset")) r.preset = b["preset"].get<std::string>();
+    session->scene_for(r);   // refused now, with the scene's own message, rather than in the status later
+    const uint64_t g = worker->start([this, r](SerialWorker& w, uint64_t gen) { session->inflate(r, w, gen); });
+    answer_json(res, {{"generation", g}}, 202);
+  });
+  http.Get("/api/scope.png", [this](const httplib::Request& q, httplib::Response& res) {
+    const ScopeRequest r = scope_request(q);
+    res.set_content(on_worker([&] { return session->scope_png(r); }), "image/png");
+  });
+  http.Get("/api/exterior.png", [this](const httplib::Request& q, httplib::Response& res) {
+    const std::string side = q.has_param("side") ? q.get_param_value("side") : "anterior";
+    const int w = int(number(q, "w", 480)), h = int(number(q, "h", 360));
+    std::vector<Vec3> ports;
+    if (q.has_param("ports")) {
+      std::stringstream all(q.get_param_value("ports"));
+      std::string one;
+      while (std::getline(all, one, ';') && ports.size() < 16) {
+        Vec3 p;
+        if (std::sscanf(one.c_str(), "%lf,%lf,%lf", &p.x(), &p.y(), &p.z()) != 3 || !p.allFinite())
+          throw InputError("ports: x,y,z;x,y,z expected");
+        ports.push_back(p);
+      }
+    }
+    res.set_content(on_worker([&] { return session->exterior_png(side, w, h, ports); }), "image/png");
+  });
+  http.Post("/api/pick", [this](const httplib::Request& q, httplib::Response& res) {
+    const nlohmann::json b = body_json(q);
+    const double x = b.value("x", -1.0), y = b.value("y", -1.0);
+    const std::optional<Vec3> p = on_worker([&] { return session->pick(x, y); });
+    answer_json(res, {{"skin_point_mm", p ? nlohmann::json{p->x(), p->y(), p->z()} : nlohmann::json()}});
+  });
+  http.Get("/api/slices.png", [this](const httplib::Request&, httplib::Response& res) {
+    res.set_content(on_worker([&] { return session->slices_png(); }), "image/png");
+  });
+  http.Post("/api/plan", [this](const httplib::Request& q, httplib::Response& res) {
+    start_plan(body_json(q));
+    std::lock_guard<std::mutex> lock(plan_mutex);
+    answer_json(res, plan_status, 202);
+  });
+  http.Get("/plan/report.html", [this](const httplib::Request&, httplib::Response& res) {
+    const fs::path report = fs::path(opt.out_dir) / "plan" / "report.html";
+    std::ifstream is(report, std::ios::binary);
+    if (!is) throw InputError("no plan report yet");
+    std::stringstream ss;
+    ss << is.rdbuf();
+    res.set_content(ss.str(), "text/html; charset=utf-8");
+  });
+}
+
+int serve_until_signalled(const ServeOptions& options) {
+  // SIGINT and SIGTERM go to one watcher thread, which stops the server: blocked here, before any
+  // thread starts, so every thread inherits the mask and none is interrupted in the middle of work.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  Server server(options);
+  const int port = server.bind();
+  std::atomic<bool> done{false};
+  std::thread watcher([&] {
+    const timespec tick{0, 200 * 1000 * 1000};
+    while (!done) {
+      const int sig = sigtimedwait(&signals, nullptr, &tick);
+      if (sig == SIGINT || sig == SIGTERM) {
+        log::info("serve: stopping");
+        server.stop();
+        return;
+      }
+    }
+  });
+  std::printf("serve: http://%s:%d/ (Ctrl-C stops)\n", options.host.c_str(), port);
+  std::fflush(stdout);
+  server.listen();
+  done = true;
+  watcher.join();
+  return 0;
+}
+
+}  // namespace pneumo::serve

@@ -1,0 +1,64 @@
+#pragma once
+// `pneumo serve SCENE`: one case resident (planning_session.h) behind a local web page and its HTTP
+// API (cpp-httplib). The API, all JSON or PNG:
+//   GET  /                      the page (index.html, app.js, style.css, embedded)
+//   GET  /api/status            settings, solve progress, the last equilibrium's figures, the scene's
+//                               ports and labels
+//   POST /api/inflate           {"pressure_mmhg", "wall_young_kpa", "preset"}: a re-inflation from the
+//                               last equilibrium; latest wins (202 with its generation)
+//   GET  /api/scope.png         the laparoscope at a port: sx,sy,sz (skin point, CT as given, mm),
+//                               label or tx,ty,tz (target), ins, fov, obl, roll, yaw, pitch, w, h
+//   GET  /api/exterior.png      side=anterior|left, w, h, ports=x,y,z;x,y,z (marked)
+//   POST /api/pick              {"x", "y"} on the last exterior view → {"skin_point_mm"} (CT as given)
+//   GET  /api/slices.png        axial, coronal, sagittal before and after
+//   POST /api/plan              {"ports": [...]}: writes OUT/plan.json and starts `pneumo run` on it
+//                               into OUT/plan (202); its report at GET /plan/report.html
+// Safe by default: it binds 127.0.0.1 unless told otherwise (and warns when not); no file path or
+// scene text is taken from a client (the plan's ports are checked as a scene's); request bodies up
+// to kMaxBodyBytes; at most kMaxRequestsPerSecond requests a second (429 beyond); views queue on one
+// worker (503 when kMaxShortTasks wait); SIGINT and SIGTERM stop it cleanly.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "render/gl_context.h"
+
+namespace pneumo::serve {
+
+inline constexpr std::size_t kMaxBodyBytes = 64 * 1024;
+inline constexpr int kMaxRequestsPerSecond = 200;
+
+struct ServeOptions {
+  std::string scene_path;
+  std::string host = "127.0.0.1";
+  int port = 8080;                 // 0: any free port (the tests')
+  std::string out_dir = "out/serve";   // where plans and their reports go
+  GlBackend backend = GlBackend::Auto;
+  std::string self_exe;            // the pneumo binary a plan runs (default /proc/self/exe)
+  int requests_per_second = kMaxRequestsPerSecond;
+};
+
+class Server {
+ public:
+  /// Loads the case (roles, mesh; the renderer) and starts the first inflation at the scene's
+  /// settings. InputError for a bad scene.
+  explicit Server(ServeOptions options);
+  ~Server();
+  /// Binds; returns the port (the one asked for, or the free one picked for port 0). Throws
+  /// std::runtime_error when the address cannot be bound.
+  int bind();
+  /// Serves until stop() (another thread, or the signal watcher).
+  void listen();
+  void stop();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// `pneumo serve`: the server until SIGINT or SIGTERM; returns the exit code.
+int serve_until_signalled(const ServeOptions& options);
+
+}  // namespace pneumo::serve

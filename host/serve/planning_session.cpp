@@ -1,0 +1,296 @@
+#include "serve/planning_session.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/units.h"
+#include "image/png.h"
+#include "mesh/deformation_file.h"
+#include "pipeline/exterior_views.h"
+#include "pipeline/render_scene.h"
+#include "pipeline/scene_stages.h"
+#include "render/image_out.h"
+#include "render/poses.h"
+#include "report/slices.h"
+
+namespace pneumo::serve {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// The page's pressures: up to 40 mmHg, well past the 12–15 of practice and the 30 of McDougall's
+/// curve; a slider cannot reach beyond, and the API refuses it.
+constexpr double kMaxPressureMmHg = 40.0;
+
+}  // namespace
+
+PlanningSession::PlanningSession(nlohmann::json scene_json, std::string scene_path, GlBackend backend)
+    : scene_json_(std::move(scene_json)),
+      scene_path_(std::move(scene_path)),
+      scene_(parse_scene(scene_json_, scene_path_)),
+      renderer_(false, backend) {
+  sim_ = prepare_simulation(scene_);
+  x_ = sim_.mesh.rest_m;
+  {
+    std::lock_guard<std::mutex> lock(status_mutex_);
+    status_ = nlohmann::json{{"pressure_mmhg", 0.0},
+             {"target_pressure_mmhg", scene_.load.pressure_mmhg},
+             {"wall_young_kpa", scene_.material.wall_young_kpa.value_or(scene_.material.young_kpa)},
+             {"preset", scene_json_.value("preset", std::string("none"))},
+             {"solving", false},
+             {"converged", false},
+             {"step", 0},
+             {"shape", 0},
+             {"tetrahedra", int64_t(sim_.mesh.tets.size())},
+             {"renderer", renderer_.describe()}};
+  }
+  refresh_shape(x_, 0.0);
+}
+
+InflateRequest PlanningSession::merged(const InflateRequest& r) const {
+  std::lock_guard<std::mutex> lock(status_mutex_);
+  InflateRequest m = settings_;
+  if (r.pressure_mmhg) m.pressure_mmhg = r.pressure_mmhg;
+  if (r.wall_young_kpa) m.wall_young_kpa = r.wall_young_kpa;
+  if (r.preset) m.preset = r.preset;
+  return m;
+}
+
+Scene PlanningSession::scene_for(const InflateRequest& request) const {
+  const InflateRequest r = merged(request);
+  nlohmann::json j = scene_json_;
+  if (r.pressure_mmhg) {
+    if (!(*r.pressure_mmhg >= 0.0 && *r.pressure_mmhg <= kMaxPressureMmHg))
+      throw InputError("pressure_mmhg must be 0 to 40");
+    j["load"]["pressure_mmhg"] = *r.pressure_mmhg;
+  }
+  if (r.wall_young_kpa) j["material"]["wall_young_kpa"] = *r.wall_young_kpa;
+  if (r.preset) {
+    if (*r.preset != "preview" && *r.preset != "balanced" && *r.preset != "accurate")
+      throw InputError("preset must be preview, balanced or accurate");
+    j["preset"] = *r.preset;
+  }
+  j["load"].erase("pressure_curve_mmhg");   // one pressure at a time here
+  return parse_scene(j, scene_path_);       // the scene's own checks (a stiffness out of range, …)
+}
+
+void PlanningSession::inflate(const InflateRequest& request, SerialWorker& worker, uint64_t generation) {
+  const InflateRequest settings = merged(request);
+  const Scene next = scene_for(settings);
+  const auto t0 = Clock::now();
+  {
+    std::lock_guard<std::mutex> lock(status_mutex_);
+    settings_ = settings;
+    status_["solving"] = true;
+    status_["converged"] = false;
+    status_["error"] = nullptr;
+    status_["target_pressure_mmhg"] = next.load.pressure_mmhg;
+    status_["wall_young_kpa"] = next.material.wall_young_kpa.value_or(next.material.young_kpa);
+    if (request.preset) status_["preset"] = *request.preset;
+    status_["generation"] = generation;
+  }
+  // Another lattice (the preset's cube size) is another mesh: roles and mesh again, from rest.
+  // Another stiffness is the same mesh with other moduli: rebuilt, and the shape carries over.
+  const bool new_mesh = next.mesh.cube_voxels != scene_.mesh.cube_voxels || next.mesh.cube_mm != scene_.mesh.cube_mm;
+  if (new_mesh) {
+    last_exterior_.reset();   // a pick on it would map through roles that are gone
+    sim_ = prepare_simulation(next);
+    x_ = sim_.mesh.rest_m;
+    pressure_pa_ = 0.0;
+    scene_ = next;
+    refresh_shape(x_, 0.0);   // before any view is answered: the point map referred to the old roles
+  } else if (next.echo()["material"] != scene_.echo()["material"]) {
+    sim_.mesh = build_scene_mesh(VoxelRoles{sim_.roles.geometry, sim_.roles.role.data(), sim_.roles.label.data(),
+                                            sim_.roles.hu()},
+                                 next, /*to_solve=*/true);
+  }
+  scene_ = next;
+  worker.checkpoint(generation);
+
+  SolveHooks hooks;
+  hooks.x_start = x_;
+  hooks.start_pressure_pa = pressure_pa_;
+  hooks.snapshot_every_steps = 1;
+  auto last_refresh = Clock::now();
+  double refresh_cost_s = 0.0;
+  hooks.on_snapshot = [&](const SolverSnapshot& s) {
+    {
+      std::lock_guard<std::mutex> lock(status_mutex_);
+      status_["step"] = s.step;
+      status_["pressure_mmhg"] = s.pressure_pa / units::kPaPerMmHg;
+      status_["seconds"] = seconds_since(t0);
+    }
+    if (seconds_since(last_refresh) >= std::max(kShapeRefreshSeconds, 2.0 * refresh_cost_s)) {
+      const auto r0 = Clock::now();
+      refresh_shape(s.x, s.pressure_pa);
+      last_refresh = Clock::now();
+      refresh_cost_s = seconds_since(r0);
+    }
+    worker.checkpoint(generation);
+  };
+  solve_simulation(scene_, sim_, hooks);
+  x_ = sim_.result.x;
+  pressure_pa_ = sim_.result.final_pressure_pa;
+  refresh_shape(x_, pressure_pa_);
+  const DeformationMetrics d = deformation_metrics(sim_.mesh, x_);
+  std::lock_guard<std::mutex> lock(status_mutex_);
+  status_["solving"] = false;
+  status_["converged"] = sim_.result.converged;
+  status_["pressure_mmhg"] = pressure_pa_ / units::kPaPerMmHg;
+  status_["anterior_rise_mm"] = d.anterior_rise_mm;
+  status_["cavity_volume_ml"] = d.cavity_volume_ml;
+  status_["viscera_back_mm"] = d.anterior_viscera_posterior_motion_mm;
+  status_["seconds"] = seconds_since(t0);
+  status_["steps"] = sim_.result.steps;
+  status_["tetrahedra"] = int64_t(sim_.mesh.tets.size());
+}
+
+void PlanningSession::refresh_shape(const std::vector<Vec3>& x, double pressure_pa) {
+  shown_pressure_pa_ = pressure_pa;
+  warp_mesh_ = std::make_shared<const WarpMesh>(make_warp_mesh(sim_.mesh, displacements(sim_.mesh, x)));
+  point_map_ = std::make_shared<const PointMap>(*warp_mesh_, sim_.roles.role.data());
+  WarpSource src;
+  src.ct_hu = sim_.roles.ct.data<float>();
+  src.labels = sim_.roles.label.data();
+  src.roles = sim_.roles.role.data();
+  WarpOptions wo;
+  wo.cavity_label = uint16_t(scene_.output.cavity_label);
+  const Geometry& g = sim_.roles.geometry;
+  const WarpResult& w = warps_.warp(scene_.device, *warp_mesh_, src, WarpBox{{0, 0, 0}, g.dims}, wo);
+  deformed_ct_ = std::make_unique<Volume>(g, VoxelType::Float32);
+  std::copy(w.ct_hu.begin(), w.ct_hu.end(), deformed_ct_->data<float>());
+  Volume labels(g, VoxelType::UInt16);
+  std::copy(w.labels.begin(), w.labels.end(), labels.data<uint16_t>());
+  volume_ = std::make_unique<RenderVolume>(RenderVolume::from(*deformed_ct_, &labels));
+  renderer_.set_volume(*volume_);
+  std::lock_guard<std::mutex> lock(status_mutex_);
+  status_["shape"] = status_.value("shape", 0) + 1;
+  status_["cavity_voxels"] = w.gas_voxels;
+}
+
+PointMapFn PlanningSession::to_deformed() const { return deformed_point_fn(*point_map_, false); }
+
+std::string PlanningSession::scope_png(const ScopeRequest& q) {
+  if (!(q.width >= 16 && q.width <= 1920 && q.height >= 16 && q.height <= 1080))
+    throw InputError("the view must be 16 to 1920 × 16 to 1080 pixels");
+  // The scene's own limits for a port (docs/scene_reference.md).
+  if (!(q.fov_deg > 0 && q.fov_deg < 180)) throw InputError("fov_deg must be above 0 and below 180");
+  if (!(q.oblique_deg >= 0 && q.oblique_deg <= 90)) throw InputError("oblique_deg must be 0 to 90");
+  if (!(q.roll_deg >= -180 && q.roll_deg <= 180)) throw InputError("roll_deg must be -180 to 180");
+  if (!(q.insertion_mm >= 0 && q.insertion_mm <= 500)) throw InputError("insertion_mm must be 0 to 500");
+  if (!(std::abs(q.yaw_deg) <= 180 && std::abs(q.pitch_deg) <= 89)) throw InputError("yaw_deg ±180, pitch_deg ±89");
+  const PointMapFn map = to_deformed();
+  Vec3 target;
+  if (q.target_label) target = label_centroid_mm(*volume_, *q.target_label);
+  else if (q.target_mm) target = map(*q.target_mm);
+  else throw InputError("a port needs a target: an organ label or a point");
+  const Vec3 skin = map(q.skin_point_mm);
+  // Aiming: the axis from the skin point to the target, turned by yaw about the superior axis and
+  // by pitch about the axis's own right.
+  Vec3 axis = target - skin;
+  if (axis.norm() < 1e-6) throw InputError("the target lies on the port's skin point");
+  const Vec3 up(0, 0, 1);
+  axis = Eigen::AngleAxisd(q.yaw_deg * M_PI / 180.0, up) * axis;
+  Vec3 right = axis.cross(up);
+  if (right.norm() > 1e-9)
+    axis = Eigen::AngleAxisd(q.pitch_deg * M_PI / 180.0, right.normalized()) * axis;
+  const ScopePose pose = port_pose(q.skin_point_mm, skin + axis, q.insertion_mm, map, up);
+  Optics optics;
+  optics.fov_deg = q.fov_deg;
+  optics.oblique_deg = q.oblique_deg;
+  optics.roll_deg = q.roll_deg;
+  const ViewCamera camera = make_view_camera(pose, optics, q.width, q.height);
+  const RenderImage image = renderer_.render(camera, settings_from_scene(scene_.render, volume_->geometry));
+  RgbImage rgb(image.width, image.height);
+  rgb.rgb = to_rgb8(image);
+  return encode_png(rgb);
+}
+
+std::string PlanningSession::exterior_png(const std::string& side, int width, int height,
+                                          const std::vector<Vec3>& ports_mm) {
+  if (!(width >= 16 && width <= 1920 && height >= 16 && height <= 1080))
+    throw InputError("the view must be 16 to 1920 × 16 to 1080 pixels");
+  const std::string name = "exterior_" + side;
+  for (const ExteriorCamera& c : exterior_cameras(volume_->geometry, width, height)) {
+    if (c.name != name) continue;
+    const RenderSettings s = skin_settings(settings_from_scene(scene_.render, volume_->geometry), c.camera,
+                                           volume_->geometry);
+    const RenderImage image = renderer_.render(c.camera, s);
+    const PointMapFn map = to_deformed();
+    std::vector<SkinMark> marks;
+    for (std::size_t k = 0; k < ports_mm.size(); ++k) marks.push_back({"port " + std::to_string(k + 1), map(ports_mm[k])});
+    char caption[64];
+    std::snprintf(caption, sizeof caption, "%.1f mmHg", shown_pressure_pa_ / units::kPaPerMmHg);
+    const AnnotatedView a = annotated_view(image, c.camera, caption, marks);
+    last_exterior_ = Exterior{c.camera, image.depth_mm, warp_mesh_, point_map_};
+    return encode_png(a.image);
+  }
+  throw InputError("side must be anterior or left");
+}
+
+std::optional<Vec3> PlanningSession::pick(double x_px, double y_px) {
+  if (!last_exterior_) throw InputError("no exterior view to pick on: ask for one first");
+  const ViewCamera& c = last_exterior_->camera;
+  if (!(x_px >= 0 && y_px >= 0 && x_px < c.width && y_px < c.height)) return std::nullopt;
+  const float depth = last_exterior_->depth_mm[std::size_t(int(y_px) * c.width + int(x_px))];
+  const std::optional<Vec3> ray = c.ray(x_px + 0.5, y_px + 0.5);
+  if (!(depth > 0.0f) || !ray) return std::nullopt;
+  // The deformed skin point, carried back to the CT as given: a port is planned there and travels.
+  // The first surface's depth is where the skin's opacity begins, within a voxel of the mesh's own
+  // boundary: the first point a little deeper that a tetrahedron carries is the skin point. A ray
+  // that met no surface has no depth (0 or infinite).
+  if (!std::isfinite(depth)) return std::nullopt;
+  const double step = 0.5 * volume_->geometry.spacing_mm.minCoeff();
+  for (int k = 0; k <= 8; ++k) {
+    const MappedPoint back = last_exterior_->point_map->to_original(c.position_mm + (double(depth) + k * step) * *ray);
+    if (back.carried) return back.point_mm;
+  }
+  return std::nullopt;
+}
+
+std::string PlanningSession::slices_png() {
+  SliceView view;
+  view.title = "before";
+  const RgbImage before = render_slice_row(sim_.roles.ct, nullptr, view);
+  char title[96];
+  std::snprintf(title, sizeof title, "after, %.1f mmHg", shown_pressure_pa_ / units::kPaPerMmHg);
+  view.title = title;
+  return encode_png(stack_rows({before, render_slice_row(*deformed_ct_, nullptr, view)}));
+}
+
+nlohmann::json PlanningSession::plan_json(const std::vector<std::pair<std::string, ScopeRequest>>& ports) const {
+  nlohmann::json j = scene_json_;
+  j["load"]["pressure_mmhg"] = scene_.load.pressure_mmhg;
+  if (scene_.material.wall_young_kpa) j["material"]["wall_young_kpa"] = *scene_.material.wall_young_kpa;
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& [name, q] : ports) {
+    nlohmann::json p = {{"name", name},
+                        {"skin_point_mm", {q.skin_point_mm.x(), q.skin_point_mm.y(), q.skin_point_mm.z()}},
+                        {"insertion_mm", q.insertion_mm},
+                        {"fov_deg", q.fov_deg},
+                        {"oblique_deg", q.oblique_deg},
+                        {"roll_deg", q.roll_deg}};
+    if (q.target_label) p["target_label"] = *q.target_label;
+    else if (q.target_mm) p["target_mm"] = {q.target_mm->x(), q.target_mm->y(), q.target_mm->z()};
+    list.push_back(p);
+  }
+  j["render"]["ports"] = list;
+  return j;
+}
+
+nlohmann::json PlanningSession::status() const {
+  std::lock_guard<std::mutex> lock(status_mutex_);
+  return status_;
+}
+
+void PlanningSession::set_error(const std::string& message) {
+  std::lock_guard<std::mutex> lock(status_mutex_);
+  status_["solving"] = false;
+  status_["error"] = message;
+}
+
+}  // namespace pneumo::serve

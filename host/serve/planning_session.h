@@ -1,0 +1,118 @@
+#pragma once
+// What `pneumo serve` keeps resident for one case (issue 22): the scene, its roles and mesh, the
+// current equilibrium, the CT warped through it and the renderer holding that volume. A pressure or
+// stiffness change continues from the last equilibrium (a warm start: the solver starts at its shape
+// and pressure), and while it converges the warped volume is refreshed every kShapeRefreshSeconds,
+// so the views show the abdomen moving. Every method runs on the SerialWorker's thread (the GL
+// context and the solver state live there); status() alone may be called from any thread.
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/geometry.h"
+#include "pipeline/simulate.h"
+#include "render/gl_context.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
+#include "serve/serial_worker.h"
+#include "warp/point_map.h"
+#include "warp/warp.h"
+
+namespace pneumo::serve {
+
+/// What the page may change; everything else comes from the scene file. Absent = as the last
+/// request left it (at first, the scene file's).
+struct InflateRequest {
+  std::optional<double> pressure_mmhg;    // 0 … 40
+  std::optional<double> wall_young_kpa;   // within the scene's limits
+  std::optional<std::string> preset;      // "preview", "balanced", "accurate"
+};
+
+/// A laparoscope at a port: the skin point on the CT as given (it travels with the skin), the
+/// target (an organ label's centroid, or a point on the CT as given), and the scope's optics.
+/// yaw and pitch turn the axis from the target about the skin point (degrees; dragging aims).
+struct ScopeRequest {
+  Vec3 skin_point_mm = Vec3::Zero();
+  std::optional<int> target_label;
+  std::optional<Vec3> target_mm;
+  double insertion_mm = 60.0, fov_deg = 70.0, oblique_deg = 30.0, roll_deg = 0.0;
+  double yaw_deg = 0.0, pitch_deg = 0.0;
+  int width = 480, height = 360;
+};
+
+class PlanningSession {
+ public:
+  /// The views follow the solve at most this often, and spend at most a third of the time on it
+  /// (a refresh warps the CT and uploads the volume: about a second on the medium phantom here).
+  static constexpr double kShapeRefreshSeconds = 0.7;
+
+  /// `scene_json` is the scene file as written (presets apply to it when changed), `scene_path` its
+  /// path (relative paths resolve from its folder).
+  PlanningSession(nlohmann::json scene_json, std::string scene_path, GlBackend backend);
+
+  /// The scene a request asks for (its values over the settings of the last request, over the
+  /// scene file's), checked as any scene is (InputError naming what is wrong), without touching the
+  /// case: what the server calls before it answers. Any thread.
+  Scene scene_for(const InflateRequest& r) const;
+
+  /// Solves at the request's settings from the last equilibrium (from rest when the preset changes
+  /// the mesh), checking `worker` at every solver snapshot: views asked for meanwhile are answered,
+  /// and a newer request stops this one (SerialWorker::Superseded).
+  void inflate(const InflateRequest& request, SerialWorker& worker, uint64_t generation);
+
+  /// The laparoscope's view on the current shape, as PNG bytes. InputError for a pose that leaves
+  /// the volume or an unknown label.
+  std::string scope_png(const ScopeRequest& request);
+  /// The skin from outside ("anterior" or "left"), after inflation, the given ports marked; the
+  /// camera is kept for pick().
+  std::string exterior_png(const std::string& side, int width, int height, const std::vector<Vec3>& ports_mm);
+  /// The skin point under pixel (x, y) of the last exterior view, on the CT as given (carried back
+  /// through the deformation); nullopt where the ray met no skin.
+  std::optional<Vec3> pick(double x_px, double y_px);
+  /// Axial, coronal and sagittal slices before and after, through `at_mm` (default: the cavity).
+  std::string slices_png();
+
+  /// The scene as it now stands (the file's text with the changes made), to save as a plan.
+  nlohmann::json plan_json(const std::vector<std::pair<std::string, ScopeRequest>>& ports) const;
+
+  /// Thread-safe: the settings, the solve's progress and the last equilibrium's figures.
+  nlohmann::json status() const;
+  void set_error(const std::string& message);
+
+ private:
+  void refresh_shape(const std::vector<Vec3>& x, double pressure_pa);   // warp and upload
+  InflateRequest merged(const InflateRequest& r) const;                 // r over settings_
+  PointMapFn to_deformed() const;
+
+  nlohmann::json scene_json_;
+  std::string scene_path_;
+  Scene scene_;
+  Simulation sim_;
+  std::vector<Vec3> x_;             // the current shape (m), sim_.mesh.rest_m before the first solve
+  double pressure_pa_ = 0.0;        // the pressure x_ is in equilibrium with (0: rest)
+  double shown_pressure_pa_ = 0.0;  // the pressure of the shape the views show (mid-solve: the solver's)
+  std::shared_ptr<const WarpMesh> warp_mesh_;
+  std::shared_ptr<const PointMap> point_map_;   // refers to *warp_mesh_ and sim_.roles
+  WarpSeries warps_;
+  std::unique_ptr<RenderVolume> volume_;
+  std::unique_ptr<Volume> deformed_ct_;
+  Renderer renderer_;
+  struct Exterior {   // the last exterior view: a pick is made on what the user saw
+    ViewCamera camera;
+    std::vector<float> depth_mm;
+    std::shared_ptr<const WarpMesh> warp_mesh;    // the shape it showed, kept while picked on
+    std::shared_ptr<const PointMap> point_map;
+  };
+  std::optional<Exterior> last_exterior_;
+
+  mutable std::mutex status_mutex_;   // guards status_ and settings_
+  nlohmann::json status_;
+  InflateRequest settings_;           // the last request's values, merged (absent: the scene file's)
+};
+
+}  // namespace pneumo::serve

@@ -1,0 +1,156 @@
+#pragma once
+// The one thread of `pneumo serve` that owns the OpenGL context and the solver's state: an EGL or
+// OSMesa context is current on one thread, and the shape being solved is not shared. Two kinds of
+// work reach it:
+//  - short tasks (render a view, pick a point on the skin): queued, run in order, each answered
+//    through a future; at most kMaxShortTasks wait, beyond that run() refuses (the server answers
+//    503), so a flood of requests cannot grow memory without bound;
+//  - long tasks (a re-inflation), one at a time, latest wins: starting one supersedes the one
+//    running, which stops at its next checkpoint, and replaces any still waiting.
+// A long task calls checkpoint() at each solver snapshot: the short tasks waiting are answered
+// there, so the views keep coming while a solve runs, and a superseded task stops by throwing
+// Superseded, which the worker swallows.
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <exception>
+#include <functional>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <utility>
+
+namespace pneumo::serve {
+
+class SerialWorker {
+ public:
+  static constexpr std::size_t kMaxShortTasks = 32;
+
+  /// Thrown by checkpoint() in a long task that a newer one replaced, or when the worker stops.
+  struct Superseded : std::exception {
+    const char* what() const noexcept override { return "superseded by a newer request"; }
+  };
+  /// Thrown by run() when kMaxShortTasks already wait.
+  struct Busy : std::runtime_error {
+    Busy() : std::runtime_error("too many requests waiting; try again") {}
+  };
+
+  using LongTask = std::function<void(SerialWorker&, uint64_t generation)>;
+  /// Called on the worker with a long task's error (not Superseded), for the status to report.
+  using ErrorSink = std::function<void(const std::string&)>;
+
+  /// `at_exit` runs on the worker as it ends (what the thread owns, as a GL context, ends there).
+  explicit SerialWorker(ErrorSink on_error = {}, std::function<void()> at_exit = {})
+      : on_error_(std::move(on_error)), at_exit_(std::move(at_exit)), thread_([this] {
+          loop();
+          if (at_exit_) at_exit_();
+        }) {}
+  ~SerialWorker() { stop(); }
+  SerialWorker(const SerialWorker&) = delete;
+  SerialWorker& operator=(const SerialWorker&) = delete;
+
+  /// Runs `f` on the worker; its result (or exception) through the future.
+  template <class F>
+  auto run(F f) -> std::future<decltype(f())> {
+    using R = decltype(f());
+    auto task = std::make_shared<std::packaged_task<R()>>(std::move(f));
+    std::future<R> result = task->get_future();
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      if (stop_) throw std::runtime_error("the server is stopping");
+      if (short_.size() >= kMaxShortTasks) throw Busy();
+      short_.emplace_back([task] { (*task)(); });
+    }
+    cv_.notify_one();
+    return result;
+  }
+
+  /// Queues `task` as the one long task to run next, superseding the one running (and any waiting).
+  /// Returns its generation.
+  uint64_t start(LongTask task) {
+    uint64_t g;
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      if (stop_) throw std::runtime_error("the server is stopping");
+      g = ++generation_;
+      long_ = std::make_pair(g, std::move(task));
+    }
+    cv_.notify_one();
+    return g;
+  }
+
+  /// The newest generation started (0: none yet).
+  uint64_t generation() const { return generation_.load(); }
+  bool superseded(uint64_t generation) const { return generation != generation_.load() || stopping_.load(); }
+
+  /// In a long task, on the worker: answers the short tasks waiting, then throws Superseded when a
+  /// newer long task was started meanwhile.
+  void checkpoint(uint64_t generation) {
+    service();
+    if (superseded(generation)) throw Superseded();
+  }
+
+  /// Stops after the task running: a long one is superseded; short ones waiting are still run.
+  void stop() {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      if (stop_) return;
+      stop_ = true;
+    }
+    stopping_ = true;
+    cv_.notify_one();
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  void service() {
+    for (;;) {
+      std::function<void()> f;
+      {
+        std::lock_guard<std::mutex> lock(m_);
+        if (short_.empty()) return;
+        f = std::move(short_.front());
+        short_.pop_front();
+      }
+      f();   // a packaged task: its exception goes to its future
+    }
+  }
+
+  void loop() {
+    for (;;) {
+      std::optional<std::pair<uint64_t, LongTask>> next;
+      {
+        std::unique_lock<std::mutex> lock(m_);
+        cv_.wait(lock, [&] { return stop_ || !short_.empty() || long_.has_value(); });
+        if (stop_ && short_.empty()) return;
+        if (short_.empty()) next.swap(long_);
+      }
+      service();
+      if (!next) continue;
+      try {
+        next->second(*this, next->first);
+      } catch (const Superseded&) {
+      } catch (const std::exception& e) {
+        if (on_error_) on_error_(e.what());
+      }
+    }
+  }
+
+  ErrorSink on_error_;
+  std::function<void()> at_exit_;
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::deque<std::function<void()>> short_;
+  std::optional<std::pair<uint64_t, LongTask>> long_;
+  std::atomic<uint64_t> generation_{0};
+  std::atomic<bool> stopping_{false};
+  bool stop_ = false;
+  std::thread thread_;   // last: starts once the members above exist
+};
+
+}  // namespace pneumo::serve

@@ -1,0 +1,106 @@
+#!/usr/bin/env python3
+"""`pneumo serve`'s page in a real browser (issue 22, item 7): headless Chromium driven by Selenium
+opens the page, waits for the first equilibrium, clicks the skin on the body's view to place a port,
+waits for the laparoscope's view, moves the pressure slider down, waits for the view to change and
+the status to report the new pressure, and saves a screenshot.
+
+Usage: serve_page.py PNEUMO SCENE SCRATCH_DIR [SCREENSHOT]
+Exit 0 when every step held, 1 when one did not (the step is printed), 77 when Chromium or its
+driver cannot start here (the caller skips, saying so).
+"""
+import re
+import subprocess
+import sys
+import time
+
+try:
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+except ImportError as e:
+    print(f"skip: python3-selenium is missing ({e}); scripts/install_deps.sh installs it")
+    sys.exit(77)
+
+pneumo, scene, scratch = sys.argv[1], sys.argv[2], sys.argv[3]
+screenshot = sys.argv[4] if len(sys.argv) > 4 else None
+
+
+def fail(step):
+    print("FAILED: " + step)
+    sys.exit(1)
+
+
+def wait_for(what, condition, seconds):
+    end = time.time() + seconds
+    while time.time() < end:
+        value = condition()
+        if value:
+            return value
+        time.sleep(0.25)
+    fail(what)
+
+
+server = subprocess.Popen([pneumo, "-q", "serve", scene, "--port", "0", "--out", scratch + "/serve_out"],
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+driver = None
+try:
+    line = server.stdout.readline()
+    m = re.search(r"http://[^:]+:(\d+)/", line)
+    if not m:
+        fail("the server printed its address (got: %r)" % line)
+    url = f"http://127.0.0.1:{m.group(1)}/"
+
+    options = webdriver.ChromeOptions()
+    for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+              "--window-size=1400,1100", f"--user-data-dir={scratch}/profile", "--force-device-scale-factor=1"):
+        options.add_argument(a)
+    options.binary_location = "/usr/bin/chromium"
+    try:
+        driver = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+    except Exception as e:  # noqa: BLE001 - any failure to start the browser is a skip, said why
+        print(f"skip: Chromium does not start here: {str(e).splitlines()[0] if str(e) else e!r}")
+        sys.exit(77)
+    driver.set_page_load_timeout(60)
+    driver.get(url)
+    status = driver.find_element(By.ID, "status")
+    wait_for("the first equilibrium (status 'converged at 12.0 mmHg')",
+             lambda: "converged at 12.0" in status.text, 240)
+
+    exterior = driver.find_element(By.ID, "exterior")
+    wait_for("the body's view", lambda: driver.execute_script(
+        "return arguments[0].complete && arguments[0].naturalWidth > 0", exterior), 60)
+    exterior.click()   # the middle of the anterior view: the skin in front of the abdomen
+    wait_for("a port placed on the skin", lambda: driver.find_elements(By.CSS_SELECTOR, "#port-list button"), 60)
+    scope = driver.find_element(By.ID, "scope")
+    wait_for("the laparoscope's view", lambda: driver.execute_script(
+        "return arguments[0].complete && arguments[0].naturalWidth === 480", scope), 60)
+    before = scope.screenshot_as_png
+
+    slider = driver.find_element(By.ID, "pressure")
+    slider.click()
+    for _ in range(20):   # from the middle down to 6 mmHg, one step per key, then the change event
+        if int(slider.get_attribute("value")) <= 6:
+            break
+        slider.send_keys(Keys.ARROW_LEFT)
+    pressure = int(slider.get_attribute("value"))
+    if pressure >= 12:
+        fail("the pressure slider moved down (it reads %d)" % pressure)
+    wait_for(f"the status at {pressure}.0 mmHg, converged",
+             lambda: f"converged at {pressure}.0" in status.text, 240)
+    wait_for("the laparoscope's view changed with the pressure",
+             lambda: driver.execute_script("return arguments[0].complete", scope) and scope.screenshot_as_png != before, 60)
+    if screenshot:
+        driver.save_screenshot(screenshot)
+    print(f"ok: port placed, view changed, status '{status.text}'")
+finally:
+    if driver:
+        driver.quit()
+    server.terminate()
+    try:
+        server.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        server.kill()
+        fail("the server stopped within 30 s of SIGTERM")
+    if server.returncode not in (0, -15):
+        fail(f"the server's exit after SIGTERM: {server.returncode}")

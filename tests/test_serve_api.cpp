@@ -1,0 +1,209 @@
+// `pneumo serve`'s HTTP API (host/serve/http_server.h) on the small phantom at `preview`, through a
+// real HTTP client on a real socket: the page and its files, the laparoscope's and the body's views
+// (PNG), a click on the skin placing a port where the skin is, a re-inflation from the last
+// equilibrium with latest-wins, bad input answered 400 with the reason, the body and rate limits,
+// and a server that stops promptly in the middle of a solve.
+#include <gtest/gtest.h>
+
+#include <httplib.h>
+#undef _res   // glibc's resolv.h macro, a parameter name in Eigen (host/serve/http_server.cpp says why)
+
+#include <chrono>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "cli_test_support.h"
+#include "core/progress.h"
+#include "phantom/phantom.h"
+#include "serve/http_server.h"
+#include "stb_image_support.h"
+
+using namespace pneumo;
+using testing_support::ScratchDir;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// The small phantom's case at `preview` (12 mm cubes: a solve of seconds), its scene's first port.
+std::string write_case(const ScratchDir& dir) {
+  write_phantom_case(make_phantom(PhantomSize::Small), PhantomSize::Small, dir.path().string());
+  nlohmann::json j = nlohmann::json::parse(testing_support::slurp(dir.file("scene.json")));
+  j["preset"] = "preview";
+  std::ofstream(dir.file("serve_scene.json")) << j.dump(2);
+  return dir.file("serve_scene.json");
+}
+
+class ServeApi : public ::testing::Test {
+ protected:
+  void start(int requests_per_second = serve::kMaxRequestsPerSecond) {
+    Progress::set_enabled(false);
+    serve::ServeOptions o;
+    o.scene_path = write_case(dir_);
+    o.port = 0;
+    o.out_dir = dir_.file("serve_out");
+    o.requests_per_second = requests_per_second;
+    server_ = std::make_unique<serve::Server>(o);
+    port_ = server_->bind();
+    listener_ = std::thread([this] { server_->listen(); });
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", port_);
+    client_->set_read_timeout(120, 0);
+  }
+  void TearDown() override {
+    if (server_) server_->stop();
+    if (listener_.joinable()) listener_.join();
+    server_.reset();
+  }
+  nlohmann::json status() { return nlohmann::json::parse(client_->Get("/api/status")->body); }
+  /// Polls until the solve of `generation` or a later one has ended; false after `seconds`.
+  bool wait_solved(uint64_t generation, double seconds = 180) {
+    const auto t0 = Clock::now();
+    while (std::chrono::duration<double>(Clock::now() - t0).count() < seconds) {
+      const nlohmann::json s = status();
+      if (!s["solving"].get<bool>() && s.value("generation", uint64_t(0)) >= generation) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    }
+    return false;
+  }
+  static std::string scope_query() { return "/api/scope.png?sx=0&sy=110&sz=-20&label=5&ins=45&obl=30&w=160&h=120"; }
+
+  ScratchDir dir_;
+  std::unique_ptr<serve::Server> server_;
+  std::thread listener_;
+  int port_ = 0;
+  std::unique_ptr<httplib::Client> client_;
+};
+
+bool is_png(const std::string& bytes) { return bytes.size() > 8 && bytes.compare(1, 3, "PNG") == 0; }
+
+int png_width(const std::string& bytes) {
+  int w = 0, h = 0, c = 0;
+  unsigned char* px = stbi_load_from_memory(reinterpret_cast<const unsigned char*>(bytes.data()), int(bytes.size()),
+                                            &w, &h, &c, 3);
+  if (px) stbi_image_free(px);
+  return w;
+}
+
+}  // namespace
+
+// Compared: what the page and its views must be (the page's own files, PNGs of the asked size), the
+// pick's truth (a ray through the middle of the anterior view meets the skin in front: on the CT as
+// given, the phantom's anterior skin lies at y ≈ 100–120 mm on the midline), and a re-inflation
+// whose figures move the way physics says (12 → 6 mmHg: a smaller cavity, a lower rise).
+TEST_F(ServeApi, PageViewsPickAndAWarmReinflation) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  const auto page = client_->Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_NE(page->body.find("<script src=\"/app.js\">"), std::string::npos);
+  EXPECT_EQ(client_->Get("/app.js")->status, 200);
+  EXPECT_EQ(client_->Get("/style.css")->status, 200);
+  ASSERT_TRUE(wait_solved(1));
+  nlohmann::json s = status();
+  EXPECT_TRUE(s["converged"].get<bool>()) << s.dump();
+  EXPECT_NEAR(s["pressure_mmhg"].get<double>(), 12.0, 1e-6);
+  const double rise12 = s["anterior_rise_mm"], cavity12 = s["cavity_volume_ml"];
+  EXPECT_GT(rise12, 10.0);
+
+  const auto scope = client_->Get(scope_query().c_str());
+  ASSERT_TRUE(scope);
+  ASSERT_EQ(scope->status, 200) << scope->body;
+  ASSERT_TRUE(is_png(scope->body));
+  EXPECT_EQ(png_width(scope->body), 160);
+  const auto ext = client_->Get("/api/exterior.png?side=anterior&w=200&h=150&ports=0,110,-20");
+  ASSERT_EQ(ext->status, 200) << ext->body;
+  EXPECT_EQ(png_width(ext->body), 200);
+  EXPECT_EQ(client_->Get("/api/slices.png")->status, 200);
+
+  const auto pick = client_->Post("/api/pick", R"({"x": 100, "y": 75})", "application/json");
+  ASSERT_EQ(pick->status, 200) << pick->body;
+  const nlohmann::json p = nlohmann::json::parse(pick->body)["skin_point_mm"];
+  ASSERT_TRUE(p.is_array()) << pick->body;
+  EXPECT_NEAR(p[0].get<double>(), 0.0, 40.0);
+  EXPECT_GT(p[1].get<double>(), 90.0);
+  EXPECT_LT(p[1].get<double>(), 130.0);
+  const auto sky = client_->Post("/api/pick", R"({"x": 2, "y": 2})", "application/json");
+  EXPECT_TRUE(nlohmann::json::parse(sky->body)["skin_point_mm"].is_null()) << "a corner of the view holds no skin";
+
+  const auto again = client_->Post("/api/inflate", R"({"pressure_mmhg": 6})", "application/json");
+  ASSERT_EQ(again->status, 202) << again->body;
+  const uint64_t g = nlohmann::json::parse(again->body)["generation"];
+  ASSERT_TRUE(wait_solved(g));
+  s = status();
+  EXPECT_TRUE(s["converged"].get<bool>()) << s.dump();
+  EXPECT_NEAR(s["pressure_mmhg"].get<double>(), 6.0, 1e-6);
+  EXPECT_LT(s["anterior_rise_mm"].get<double>(), rise12);
+  EXPECT_LT(s["cavity_volume_ml"].get<double>(), cavity12);
+  const auto scope6 = client_->Get(scope_query().c_str());
+  EXPECT_NE(scope6->body, scope->body) << "the view follows the new shape";
+}
+
+// Latest wins: two requests in a row, the first superseded before it ends; the status ends at the
+// second's pressure, under the second's generation. Then a preset that changes the mesh. Bad input is refused with its reason, before any
+// work: a pressure beyond 40 mmHg, an unknown preset, a stiffness the scene's limits refuse, a view
+// without a skin point, a field of view of 200°, a body that is no JSON object, and one over the
+// body limit (413).
+TEST_F(ServeApi, LatestWinsAndBadInputIsRefusedWithItsReason) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  const auto a = client_->Post("/api/inflate", R"({"pressure_mmhg": 20})", "application/json");
+  const auto b = client_->Post("/api/inflate", R"({"pressure_mmhg": 8})", "application/json");
+  ASSERT_EQ(a->status, 202);
+  ASSERT_EQ(b->status, 202);
+  const uint64_t gb = nlohmann::json::parse(b->body)["generation"];
+  EXPECT_GT(gb, nlohmann::json::parse(a->body)["generation"].get<uint64_t>());
+  ASSERT_TRUE(wait_solved(gb));
+  const nlohmann::json s = status();
+  EXPECT_EQ(s["generation"].get<uint64_t>(), gb);
+  EXPECT_NEAR(s["pressure_mmhg"].get<double>(), 8.0, 1e-6);
+
+  const auto refused = [&](const char* path, const std::string& body, const char* says) {
+    const auto r = body.empty() ? client_->Get(path) : client_->Post(path, body, "application/json");
+    ASSERT_TRUE(r) << path;
+    EXPECT_EQ(r->status, 400) << path << " " << body;
+    EXPECT_NE(r->body.find(says), std::string::npos) << r->body;
+  };
+  refused("/api/inflate", R"({"pressure_mmhg": 55})", "pressure_mmhg must be 0 to 40");
+  refused("/api/inflate", R"({"preset": "fastest"})", "preset must be");
+  refused("/api/inflate", R"({"wall_young_kpa": -3})", "wall_young_kpa");
+  refused("/api/inflate", R"([1, 2])", "must be a JSON object");
+  refused("/api/inflate", R"({"pressure_mmhg": "high"})", "bad request");
+  refused("/api/scope.png?label=5", "", "sx, sy, sz");
+  refused("/api/scope.png?sx=0&sy=110&sz=-20&label=5&fov=200", "", "fov_deg");
+  const auto big = client_->Post("/api/inflate", std::string(serve::kMaxBodyBytes + 10, ' '), "application/json");
+  ASSERT_TRUE(big);
+  EXPECT_EQ(big->status, 413);
+  EXPECT_EQ(status()["generation"].get<uint64_t>(), gb) << "nothing refused started a solve";
+
+  // Another preset is another lattice: roles and mesh again, from rest; a view asked for while it
+  // solves is answered from the worker's checkpoints, on the new mesh's shapes.
+  const int64_t preview_tets = status()["tetrahedra"];
+  const auto c = client_->Post("/api/inflate", R"({"preset": "balanced"})", "application/json");
+  ASSERT_EQ(c->status, 202);
+  const uint64_t gc = nlohmann::json::parse(c->body)["generation"];
+  const auto during = client_->Get(scope_query().c_str());
+  EXPECT_EQ(during->status, 200) << during->body;
+  ASSERT_TRUE(wait_solved(gc));
+  const nlohmann::json sc = status();
+  EXPECT_EQ(sc["preset"], "balanced");
+  EXPECT_GT(sc["tetrahedra"].get<int64_t>(), preview_tets);
+  EXPECT_TRUE(sc["converged"].get<bool>()) << sc.dump();
+  EXPECT_NEAR(sc["pressure_mmhg"].get<double>(), 8.0, 1e-6);
+}
+
+// Rate limit and shutdown: at 5 requests a second, a burst of 20 meets 429 for most; a server asked to
+// stop in the middle of a solve has stopped (listener returned, worker joined) within seconds.
+TEST_F(ServeApi, RateLimitAndAPromptStopMidSolve) {
+  ASSERT_NO_FATAL_FAILURE(start(5));
+  int limited = 0;
+  for (int k = 0; k < 20; ++k) limited += client_->Get("/api/status")->status == 429;
+  EXPECT_GE(limited, 10);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  ASSERT_EQ(client_->Post("/api/inflate", R"({"pressure_mmhg": 25})", "application/json")->status, 202);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const auto t0 = Clock::now();
+  server_->stop();
+  listener_.join();
+  server_.reset();   // stops the worker: the solve is superseded at its next snapshot
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - t0).count(), 20.0);
+}
