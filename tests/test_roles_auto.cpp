@@ -68,6 +68,18 @@ Scene auto_scene(double thickness_mm = 30.0, double max_angle_deg = 100.0) {
   return s;
 }
 
+/// On kIso: a "bladder" (label 21, a 12 mm sphere at x = 0, y = −10 mm, z = 22.5 mm) and, with
+/// `loop`, a "sigmoid loop" in front of its upper part (label 20, a 7 mm sphere at y = 30 mm).
+Volume bladder_labels(bool loop) {
+  Volume labels(kIso, VoxelType::UInt8);
+  for (int64_t n = 0; n < kIso.voxel_count(); ++n) {
+    const Vec3 w = kIso.to_world(Vec3(n % 81, (n / 81) % 57, n / (81 * 57)));
+    if ((w - Vec3(0, -10, 22.5)).norm() <= 12) labels.data<uint8_t>()[n] = 21;
+    if (loop && (w - Vec3(0, 30, 22.5)).norm() <= 7) labels.data<uint8_t>()[n] = 20;
+  }
+  return labels;
+}
+
 Role role_at(const RoleVolume& rv, const Vec3& w) {
   const Vec3 idx = rv.geometry.to_index(w);
   return rv.role[rv.geometry.linear_index(std::lround(idx.x()), std::lround(idx.y()), std::lround(idx.z()))];
@@ -283,11 +295,7 @@ TEST(RolesAuto, TissueInFrontOfThePrevesicalLabelsJoinsTheWall) {
   // viscera.
   Progress::set_enabled(false);
   const Volume ct = torso(kIso);
-  Volume labels(kIso, VoxelType::UInt8);
-  for (int64_t n = 0; n < kIso.voxel_count(); ++n) {
-    const Vec3 w = kIso.to_world(Vec3(n % 81, (n / 81) % 57, n / (81 * 57)));
-    if ((w - Vec3(0, -10, 22.5)).norm() <= 12) labels.data<uint8_t>()[n] = 21;
-  }
+  const Volume labels = bladder_labels(false);
   Scene s = auto_scene();
   s.roles.wall_labels = {21};
   const RoleVolume without = assign_roles(s, ct, &labels);
@@ -303,4 +311,25 @@ TEST(RolesAuto, TissueInFrontOfThePrevesicalLabelsJoinsTheWall) {
   EXPECT_EQ(role_at(with, {40, 30, 40}), Role::Viscera);
   EXPECT_EQ(role_at(with, {0, -40, 22.5}), role_at(without, {0, -40, 22.5}));
   EXPECT_EQ(role_at(with, {0, -10, 22.5}), Role::Wall);   // the sphere itself, by its label
+}
+
+TEST(RolesAuto, TissueBetweenTheBladderAndALoopInFrontOfItStaysPeritoneal) {
+  // The torso and bladder of the test above, with a "sigmoid loop" (label 20, listed as viscera, a 7 mm
+  // sphere at x = 0, y = 30 mm, z = 22.5 mm) in front of the bladder's upper part. Where an intraperitoneal
+  // organ lies in front of the bladder in a column, the peritoneum lies in front of the bladder there: the
+  // tissue between the bladder (front y = 2 mm) and the loop stays viscera (y = 12 mm), what lies in front
+  // of the loop still joins the wall (y = 50 mm), and a column beside the loop (x = 40 mm) is as before.
+  Progress::set_enabled(false);
+  const Volume ct = torso(kIso);
+  const Volume labels = bladder_labels(true);
+  Scene s = auto_scene();
+  s.roles.wall_labels = {21};
+  s.roles.viscera_labels = {20};
+  s.roles.auto_prevesical_labels = {21};
+  const RoleVolume rv = assign_roles(s, ct, &labels);
+  EXPECT_EQ(role_at(rv, {0, 30, 22.5}), Role::Viscera);   // the loop, by its label
+  EXPECT_EQ(role_at(rv, {0, 12, 22.5}), Role::Viscera);
+  EXPECT_EQ(role_at(rv, {0, 50, 22.5}), Role::Wall);
+  EXPECT_EQ(role_at(rv, {40, 12, 22.5}), Role::Wall);
+  EXPECT_EQ(role_at(rv, {0, -10, 22.5}), Role::Wall);   // the bladder, by its label
 }

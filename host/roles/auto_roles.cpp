@@ -107,14 +107,22 @@ void assign_the_shell(std::vector<Role>& role, const std::vector<uint8_t>& body,
 }
 
 /// Undecided voxels of column (slice s, lateral l) anterior to anteriority `from(s, l)` → wall; a
-/// column whose `from` is negative is left alone. Rules 5b and 6b differ only in `from`.
+/// column whose `from` is negative is left alone. Rules 5b and 6b differ only in `from`. Where an
+/// intraperitoneal organ (`peritoneal_front`, the front of roles.viscera_labels in the column) lies
+/// in front of `from`, the peritoneum lies in front of the bladder at that level: the tissue between
+/// the bladder and that organ is on the peritoneal side (mesentery, the bladder's peritoneal face), and
+/// only what lies in front of the organ becomes wall. Made wall, it had bound the loop in front of
+/// the bladder's upper part between two wall layers, and when the loop rose under pressure its place
+/// opened as gas between wall and wall in front of the bladder (docs/fidelity.md §5).
 template <class From>
-void wall_anterior_of(std::vector<Role>& role, const SliceFrame& f, const From& from) {
+void wall_anterior_of(std::vector<Role>& role, const SliceFrame& f, const std::vector<int64_t>& peritoneal_front,
+                      const From& from) {
 #pragma omp parallel for schedule(static)
   for (int64_t s = 0; s < f.n_si; ++s)
     for (int64_t l = 0; l < f.n_lat; ++l) {
-      const int64_t first = from(s, l);
+      int64_t first = from(s, l);
       if (first < 0) continue;
+      first = std::max(first, peritoneal_front[std::size_t(s * f.n_lat + l)]);
       for (int64_t a = first + 1; a < f.n_ap; ++a) {
         const int64_t v = f.index(l, f.ant(a), s);
         if (role[v] == kUndecided) role[v] = Role::Wall;
@@ -126,7 +134,8 @@ void wall_anterior_of(std::vector<Role>& role, const SliceFrame& f, const From& 
 void attach_prevesical_space(std::vector<Role>& role, const uint16_t* label, const SliceFrame& f, const RoleRules& r) {
   if (!label || r.auto_prevesical_labels.empty()) return;
   const std::vector<int64_t> fronts = front_of_labels(label, f, LabelSet(r.auto_prevesical_labels));
-  wall_anterior_of(role, f, [&](int64_t s, int64_t l) { return fronts[std::size_t(s * f.n_lat + l)]; });
+  wall_anterior_of(role, f, front_of_labels(label, f, LabelSet(r.viscera_labels)),
+                   [&](int64_t s, int64_t l) { return fronts[std::size_t(s * f.n_lat + l)]; });
 }
 
 /// Rule 6b: below the peritoneal reflection at the dome of the prevesical labels, undecided voxels
@@ -155,7 +164,8 @@ void attach_below_the_reflection(std::vector<Role>& role, const uint16_t* label,
     if (back[s] >= 0) carried = back[s];
     else back[s] = carried;   // -1 above the dome
   }
-  wall_anterior_of(role, f, [&](int64_t s, int64_t) { return back[std::size_t(s)]; });
+  wall_anterior_of(role, f, front_of_labels(label, f, LabelSet(r.viscera_labels)),
+                   [&](int64_t s, int64_t) { return back[std::size_t(s)]; });
 }
 
 /// Rule 6: undecided voxels lateral to bone (away from the midline) → fixed.

@@ -14,7 +14,10 @@
 //   5b. with auto_use_labels and a label map: undecided tissue anterior to a voxel of
 //      auto_prevesical_labels in the same axial column (same slice, same lateral position) → wall:
 //      the space of Retzius between the bladder and the wall is extraperitoneal, so no gas opens
-//      in front of the bladder (docs/fidelity.md);
+//      in front of the bladder (docs/fidelity.md). Where an organ of viscera_labels lies in front
+//      of the bladder in the column (5b and 6b alike), the wall starts at that organ's front: the
+//      peritoneum lies in front of the bladder at that level, and the tissue behind the organ is on
+//      its peritoneal side;
 //   6. deeper tissue lateral to bone that is at least 40 mm from the midline (hip joints, iliac
 //      wings, pubic rami: the gluteal, hip and thigh muscles) → fixed (lateral_to_bone.h);
 //   6b. with auto_use_labels and a label map: in the axial slices from the top (dome) of the

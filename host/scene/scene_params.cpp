@@ -125,7 +125,9 @@ const Table<RoleRules>& roles_table() {
        "auto with a label map: undecided tissue anterior to these labels in the same axial column becomes wall "
        "(the space of Retzius in front of the bladder is extraperitoneal: no gas opens there), and so does "
        "undecided tissue anterior to their back in the slices from their top down (below the peritoneal "
-       "reflection at the bladder's dome only the pouch behind it is peritoneal). TotalSegmentator: [21]."},
+       "reflection at the bladder's dome only the pouch behind it is peritoneal). Where an organ of "
+       "viscera_labels lies in front of the bladder in a column, the wall starts in front of that organ: "
+       "the peritoneum lies in front of the bladder there. TotalSegmentator: [21]."},
       {"pad_anterior_mm", &RoleRules::pad_anterior_mm, "mm", pad,
        "Air added in front of the CT so the wall has room to rise (a real CT cropped at the skin needs >= 60)."},
       {"pad_lateral_mm", &RoleRules::pad_lateral_mm, "mm", pad,
