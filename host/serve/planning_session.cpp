@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/log.h"
 #include "core/units.h"
 #include "image/png.h"
 #include "mesh/deformation_file.h"
@@ -115,7 +116,9 @@ void PlanningSession::inflate(const InflateRequest& request, SerialWorker& worke
   hooks.x_start = x_;
   hooks.start_pressure_pa = pressure_pa_;
   hooks.snapshot_every_steps = 1;
-  auto last_refresh = Clock::now();
+  // The first snapshot's shape is shown at once (the first sign the request took), later ones as
+  // often as the refresh's own cost allows.
+  auto last_refresh = Clock::now() - std::chrono::hours(1);
   double refresh_cost_s = 0.0;
   hooks.on_snapshot = [&](const SolverSnapshot& s) {
     {
@@ -129,6 +132,8 @@ void PlanningSession::inflate(const InflateRequest& request, SerialWorker& worke
       refresh_shape(s.x, s.pressure_pa);
       last_refresh = Clock::now();
       refresh_cost_s = seconds_since(r0);
+      log::debug("serve: shape of step " + std::to_string(s.step) + " shown " + std::to_string(seconds_since(t0)) +
+                 " s after the request (warp and upload " + std::to_string(refresh_cost_s) + " s)");
     }
     worker.checkpoint(generation);
   };
