@@ -235,9 +235,22 @@ void Server::Impl::start_plan(const nlohmann::json& body) {
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
+  // The run gets the default signal handling back: this process blocks SIGINT and SIGTERM (the
+  // watcher takes them) and ignores SIGPIPE (cpp-httplib), and a child inherits both, so the SIGTERM
+  // a stopping server sends it would otherwise never arrive.
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  sigset_t none, defaults;
+  sigemptyset(&none);
+  sigemptyset(&defaults);
+  for (int sig : {SIGINT, SIGTERM, SIGPIPE}) sigaddset(&defaults, sig);
+  posix_spawnattr_setsigmask(&attr, &none);
+  posix_spawnattr_setsigdefault(&attr, &defaults);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
   pid_t pid = -1;
-  if (posix_spawn(&pid, opt.self_exe.c_str(), nullptr, nullptr, argv.data(), environ) != 0)
-    throw std::runtime_error("plan: cannot start " + opt.self_exe);
+  const int spawned = posix_spawn(&pid, opt.self_exe.c_str(), nullptr, &attr, argv.data(), environ);
+  posix_spawnattr_destroy(&attr);
+  if (spawned != 0) throw std::runtime_error("plan: cannot start " + opt.self_exe);
   plan_pid = pid;
   plan_status = {{"state", "running"}, {"scene", plan_path}, {"out", report_dir}};
   if (plan_waiter.joinable()) plan_waiter.join();
@@ -358,13 +371,17 @@ int serve_until_signalled(const ServeOptions& options) {
   std::atomic<bool> done{false};
   std::thread watcher([&] {
     const timespec tick{0, 200 * 1000 * 1000};
+    bool stopping = false;
     while (!done) {
       const int sig = sigtimedwait(&signals, nullptr, &tick);
       if (sig == SIGINT || sig == SIGTERM) {
+        if (stopping) _exit(128 + sig);   // asked twice: the user will not wait for a clean stop
         log::info("serve: stopping");
-        server.stop();
-        return;
+        stopping = true;
       }
+      // Again at every tick: cpp-httplib's stop() does nothing before listen() runs, and a signal may
+      // come while the case still loads.
+      if (stopping) server.stop();
     }
   });
   std::printf("serve: http://%s:%d/ (Ctrl-C stops)\n", options.host.c_str(), port);
