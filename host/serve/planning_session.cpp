@@ -49,7 +49,7 @@ PlanningSession::PlanningSession(nlohmann::json scene_json, std::string scene_pa
              {"tetrahedra", int64_t(sim_.mesh.tets.size())},
              {"renderer", renderer_.describe()}};
   }
-  refresh_shape(x_, 0.0);
+  refresh_shape(sim_, scene_, x_, 0.0);
 }
 
 InflateRequest PlanningSession::merged(const InflateRequest& r) const {
@@ -98,12 +98,13 @@ void PlanningSession::inflate(const InflateRequest& request, SerialWorker& worke
   // Another stiffness is the same mesh with other moduli: rebuilt, and the shape carries over.
   const bool new_mesh = next.mesh.cube_voxels != scene_.mesh.cube_voxels || next.mesh.cube_mm != scene_.mesh.cube_mm;
   if (new_mesh) {
-    last_exterior_.reset();   // a pick on it would map through roles that are gone
-    sim_ = prepare_simulation(next);
+    // Prepared and shown aside, then committed: until then the views use the old case whole.
+    Simulation prepared = prepare_simulation(next);
+    refresh_shape(prepared, next, prepared.mesh.rest_m, 0.0);
+    last_exterior_.reset();   // a pick on it would map through roles that are about to go
+    sim_ = std::move(prepared);   // the roles' buffers move with it: the new point map stays valid
     x_ = sim_.mesh.rest_m;
     pressure_pa_ = 0.0;
-    scene_ = next;
-    refresh_shape(x_, 0.0);   // before any view is answered: the point map referred to the old roles
   } else if (next.echo()["material"] != scene_.echo()["material"]) {
     sim_.mesh = build_scene_mesh(VoxelRoles{sim_.roles.geometry, sim_.roles.role.data(), sim_.roles.label.data(),
                                             sim_.roles.hu()},
@@ -129,7 +130,7 @@ void PlanningSession::inflate(const InflateRequest& request, SerialWorker& worke
     }
     if (seconds_since(last_refresh) >= std::max(kShapeRefreshSeconds, 2.0 * refresh_cost_s)) {
       const auto r0 = Clock::now();
-      refresh_shape(s.x, s.pressure_pa);
+      refresh_shape(sim_, scene_, s.x, s.pressure_pa);
       last_refresh = Clock::now();
       refresh_cost_s = seconds_since(r0);
       log::debug("serve: shape of step " + std::to_string(s.step) + " shown " + std::to_string(seconds_since(t0)) +
@@ -140,7 +141,7 @@ void PlanningSession::inflate(const InflateRequest& request, SerialWorker& worke
   solve_simulation(scene_, sim_, hooks);
   x_ = sim_.result.x;
   pressure_pa_ = sim_.result.final_pressure_pa;
-  refresh_shape(x_, pressure_pa_);
+  refresh_shape(sim_, scene_, x_, pressure_pa_);
   const DeformationMetrics d = deformation_metrics(sim_.mesh, x_);
   std::lock_guard<std::mutex> lock(status_mutex_);
   status_["solving"] = false;
@@ -154,27 +155,35 @@ void PlanningSession::inflate(const InflateRequest& request, SerialWorker& worke
   status_["tetrahedra"] = int64_t(sim_.mesh.tets.size());
 }
 
-void PlanningSession::refresh_shape(const std::vector<Vec3>& x, double pressure_pa) {
-  shown_pressure_pa_ = pressure_pa;
-  warp_mesh_ = std::make_shared<const WarpMesh>(make_warp_mesh(sim_.mesh, displacements(sim_.mesh, x)));
-  point_map_ = std::make_shared<const PointMap>(*warp_mesh_, sim_.roles.role.data());
+void PlanningSession::refresh_shape(const Simulation& sim, const Scene& scene, const std::vector<Vec3>& x,
+                                    double pressure_pa) {
+  // Everything is built aside and committed at the end, so a failure (memory, the device) leaves
+  // the shape shown before intact, its point map and volume agreeing.
+  auto warp_mesh = std::make_shared<const WarpMesh>(make_warp_mesh(sim.mesh, displacements(sim.mesh, x)));
+  auto point_map = std::make_shared<const PointMap>(*warp_mesh, sim.roles.role.data());
   WarpSource src;
-  src.ct_hu = sim_.roles.ct.data<float>();
-  src.labels = sim_.roles.label.data();
-  src.roles = sim_.roles.role.data();
+  src.ct_hu = sim.roles.ct.data<float>();
+  src.labels = sim.roles.label.data();
+  src.roles = sim.roles.role.data();
   WarpOptions wo;
-  wo.cavity_label = uint16_t(scene_.output.cavity_label);
-  const Geometry& g = sim_.roles.geometry;
-  const WarpResult& w = warps_.warp(scene_.device, *warp_mesh_, src, WarpBox{{0, 0, 0}, g.dims}, wo);
-  deformed_ct_ = std::make_unique<Volume>(g, VoxelType::Float32);
-  std::copy(w.ct_hu.begin(), w.ct_hu.end(), deformed_ct_->data<float>());
+  wo.cavity_label = uint16_t(scene.output.cavity_label);
+  const Geometry& g = sim.roles.geometry;
+  const WarpResult& w = warps_.warp(scene.device, *warp_mesh, src, WarpBox{{0, 0, 0}, g.dims}, wo);
+  auto deformed_ct = std::make_unique<Volume>(g, VoxelType::Float32);
+  std::copy(w.ct_hu.begin(), w.ct_hu.end(), deformed_ct->data<float>());
   Volume labels(g, VoxelType::UInt16);
   std::copy(w.labels.begin(), w.labels.end(), labels.data<uint16_t>());
-  volume_ = std::make_unique<RenderVolume>(RenderVolume::from(*deformed_ct_, &labels));
-  renderer_.set_volume(*volume_);
+  auto volume = std::make_unique<RenderVolume>(RenderVolume::from(*deformed_ct, &labels));
+  renderer_.set_volume(*volume);
+  const int64_t gas = w.gas_voxels;
+  warp_mesh_ = std::move(warp_mesh);
+  point_map_ = std::move(point_map);
+  deformed_ct_ = std::move(deformed_ct);
+  volume_ = std::move(volume);
+  shown_pressure_pa_ = pressure_pa;
   std::lock_guard<std::mutex> lock(status_mutex_);
   status_["shape"] = status_.value("shape", 0) + 1;
-  status_["cavity_voxels"] = w.gas_voxels;
+  status_["cavity_voxels"] = gas;
 }
 
 PointMapFn PlanningSession::to_deformed() const { return deformed_point_fn(*point_map_, false); }

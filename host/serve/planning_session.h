@@ -85,7 +85,8 @@ class PlanningSession {
   void set_error(const std::string& message);
 
  private:
-  void refresh_shape(const std::vector<Vec3>& x, double pressure_pa);   // warp and upload
+  /// Warps sim's CT through shape x and uploads it: the views' volume and point map from then on.
+  void refresh_shape(const Simulation& sim, const Scene& scene, const std::vector<Vec3>& x, double pressure_pa);
   InflateRequest merged(const InflateRequest& r) const;                 // r over settings_
   PointMapFn to_deformed() const;
 
