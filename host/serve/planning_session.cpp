@@ -279,7 +279,12 @@ std::string PlanningSession::slices_png() {
 nlohmann::json PlanningSession::plan_json(const std::vector<std::pair<std::string, ScopeRequest>>& ports) const {
   nlohmann::json j = scene_json_;
   j["load"]["pressure_mmhg"] = scene_.load.pressure_mmhg;
+  j["load"].erase("pressure_curve_mmhg");   // the page solves one pressure; so does its plan
   if (scene_.material.wall_young_kpa) j["material"]["wall_young_kpa"] = *scene_.material.wall_young_kpa;
+  {
+    std::lock_guard<std::mutex> lock(status_mutex_);
+    if (settings_.preset) j["preset"] = *settings_.preset;
+  }
   nlohmann::json list = nlohmann::json::array();
   for (const auto& [name, q] : ports) {
     nlohmann::json p = {{"name", name},
