@@ -116,15 +116,20 @@ TEST_F(ServeApi, PageViewsPickAndAWarmReinflation) {
   EXPECT_EQ(png_width(ext->body), 200);
   EXPECT_EQ(client_->Get("/api/slices.png")->status, 200);
 
-  const auto pick = client_->Post("/api/pick", R"({"x": 100, "y": 75})", "application/json");
+  const auto pick = client_->Post("/api/pick", R"({"x": 100, "y": 75, "side": "anterior", "w": 200, "h": 150})",
+                                  "application/json");
   ASSERT_EQ(pick->status, 200) << pick->body;
   const nlohmann::json p = nlohmann::json::parse(pick->body)["skin_point_mm"];
   ASSERT_TRUE(p.is_array()) << pick->body;
   EXPECT_NEAR(p[0].get<double>(), 0.0, 40.0);
   EXPECT_GT(p[1].get<double>(), 90.0);
   EXPECT_LT(p[1].get<double>(), 130.0);
-  const auto sky = client_->Post("/api/pick", R"({"x": 2, "y": 2})", "application/json");
+  const auto sky = client_->Post("/api/pick", R"({"x": 2, "y": 2, "side": "anterior", "w": 200, "h": 150})",
+                                 "application/json");
   EXPECT_TRUE(nlohmann::json::parse(sky->body)["skin_point_mm"].is_null()) << "a corner of the view holds no skin";
+  // A click on a view that is no longer the last one drawn (another side) is refused, not misplaced.
+  EXPECT_EQ(client_->Post("/api/pick", R"({"x": 100, "y": 75, "side": "left", "w": 200, "h": 150})",
+                          "application/json")->status, 409);
 
   const auto again = client_->Post("/api/inflate", R"({"pressure_mmhg": 6})", "application/json");
   ASSERT_EQ(again->status, 202) << again->body;
@@ -142,8 +147,8 @@ TEST_F(ServeApi, PageViewsPickAndAWarmReinflation) {
 // Latest wins: two requests in a row, the first superseded before it ends; the status ends at the
 // second's pressure, under the second's generation. Then a preset that changes the mesh. Bad input is refused with its reason, before any
 // work: a pressure beyond 40 mmHg, an unknown preset, a stiffness the scene's limits refuse, a view
-// without a skin point, a field of view of 200°, a body that is no JSON object, and one over the
-// body limit (413).
+// without a skin point, a field of view of 200°, a body that is no JSON object, one that is not
+// declared JSON (415), a Host other than this machine's (403), and one over the body limit (413).
 TEST_F(ServeApi, LatestWinsAndBadInputIsRefusedWithItsReason) {
   ASSERT_NO_FATAL_FAILURE(start());
   const auto a = client_->Post("/api/inflate", R"({"pressure_mmhg": 20})", "application/json");
@@ -170,10 +175,15 @@ TEST_F(ServeApi, LatestWinsAndBadInputIsRefusedWithItsReason) {
   refused("/api/inflate", R"({"pressure_mmhg": "high"})", "bad request");
   refused("/api/scope.png?label=5", "", "sx, sy, sz");
   refused("/api/scope.png?sx=0&sy=110&sz=-20&label=5&fov=200", "", "fov_deg");
+  // Another site's page can send a form or text/plain without asking first: refused (415), and a
+  // Host that is not this machine's name (DNS rebinding) gets 403.
+  EXPECT_EQ(client_->Post("/api/inflate", R"({"pressure_mmhg": 5})", "text/plain")->status, 415);
+  httplib::Headers elsewhere = {{"Host", "attacker.example:80"}};
+  EXPECT_EQ(client_->Get("/api/status", elsewhere)->status, 403);
   const auto big = client_->Post("/api/inflate", std::string(serve::kMaxBodyBytes + 10, ' '), "application/json");
   ASSERT_TRUE(big);
   EXPECT_EQ(big->status, 413);
-  EXPECT_EQ(status()["generation"].get<uint64_t>(), gb) << "nothing refused started a solve";
+  EXPECT_EQ(status()["generation_latest"].get<uint64_t>(), gb) << "nothing refused started a solve";
 
   // Another preset is another lattice: roles and mesh again, from rest; a view asked for while it
   // solves is answered from the worker's checkpoints, on the new mesh's shapes.

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -50,6 +51,14 @@ const char* content_type(const std::string& path) {
   return "application/octet-stream";
 }
 
+/// A whole number in [lo, hi] (image sizes, label ids): checked on the double, before any cast.
+int whole(double d, const char* key, double lo, double hi) {
+  if (!(d >= lo && d <= hi && d == std::floor(d)))
+    throw InputError(std::string(key) + " must be a whole number from " + std::to_string(int64_t(lo)) + " to " +
+                     std::to_string(int64_t(hi)));
+  return int(d);
+}
+
 double number(const httplib::Request& q, const char* key, double fallback) {
   if (!q.has_param(key)) return fallback;
   const std::string v = q.get_param_value(key);
@@ -71,7 +80,7 @@ ScopeRequest scope_request(const httplib::Request& q) {
   ScopeRequest s;
   s.skin_point_mm = Vec3(number(q, "sx", NAN), number(q, "sy", NAN), number(q, "sz", NAN));
   if (!s.skin_point_mm.allFinite()) throw InputError("sx, sy, sz (the port's skin point, mm) are required");
-  if (q.has_param("label")) s.target_label = int(number(q, "label", 0));
+  if (q.has_param("label")) s.target_label = whole(number(q, "label", 0), "label", 1, 65535);
   else s.target_mm = Vec3(number(q, "tx", NAN), number(q, "ty", NAN), number(q, "tz", NAN));
   if (s.target_mm && !s.target_mm->allFinite()) throw InputError("label or tx, ty, tz (the target) are required");
   s.insertion_mm = number(q, "ins", s.insertion_mm);
@@ -80,8 +89,8 @@ ScopeRequest scope_request(const httplib::Request& q) {
   s.roll_deg = number(q, "roll", s.roll_deg);
   s.yaw_deg = number(q, "yaw", 0.0);
   s.pitch_deg = number(q, "pitch", 0.0);
-  s.width = int(number(q, "w", s.width));
-  s.height = int(number(q, "h", s.height));
+  s.width = whole(number(q, "w", s.width), "w", 16, 1920);
+  s.height = whole(number(q, "h", s.height), "h", 16, 1080);
   return s;
 }
 
@@ -101,6 +110,10 @@ void answer_json(httplib::Response& res, const nlohmann::json& j, int status = 2
   res.status = status;
   res.set_content(j.dump(), "application/json");
 }
+
+struct PlanRunning : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 /// Requests a second over the whole server, counted in one-second windows.
 class RateLimit {
@@ -228,7 +241,7 @@ void Server::Impl::start_plan(const nlohmann::json& body) {
   const std::string plan_path = (out / "plan.json").string();
   parse_scene(plan, plan_path);   // every port checked as a scene's, before anything runs
   std::lock_guard<std::mutex> lock(plan_mutex);
-  if (plan_pid > 0) throw InputError("plan: a plan's run is still going; wait for it");
+  if (plan_pid > 0) throw PlanRunning("plan: a plan's run is still going; wait for it");
   write_text_file_atomic(plan_path, plan.dump(2) + "\n");
   const std::string report_dir = (out / "plan").string();
   std::vector<std::string> args = {opt.self_exe, "-q", "run", plan_path, "--out", report_dir, "--force"};
@@ -267,12 +280,34 @@ void Server::Impl::start_plan(const nlohmann::json& body) {
 
 void Server::Impl::routes() {
   rate.per_second = opt.requests_per_second;
-  http.new_task_queue = [] { return new httplib::ThreadPool(4); };
+  // More request threads than views may wait for the worker (SerialWorker::kMaxShortTasks), so the
+  // status and the controls always find one; idle keep-alive connections let go of theirs soon.
+  http.new_task_queue = [] { return new httplib::ThreadPool(12); };
+  http.set_keep_alive_timeout(1);
   http.set_payload_max_length(kMaxBodyBytes);
-  http.set_pre_routing_handler([this](const httplib::Request&, httplib::Response& res) {
-    if (rate.allow()) return httplib::Server::HandlerResponse::Unhandled;
-    answer_json(res, {{"error", "too many requests"}}, 429);
-    return httplib::Server::HandlerResponse::Handled;
+  const bool loopback = opt.host == "127.0.0.1" || opt.host == "localhost" || opt.host == "::1";
+  http.set_pre_routing_handler([this, loopback](const httplib::Request& q, httplib::Response& res) {
+    if (!rate.allow()) {
+      answer_json(res, {{"error", "too many requests"}}, 429);
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    // Bound to this machine, only this machine's names may reach it: a web page elsewhere that
+    // rebinds its own name to 127.0.0.1 (DNS rebinding) would otherwise read the case's images.
+    if (loopback) {
+      const std::string host = q.get_header_value("Host");
+      const std::string name = host.substr(0, host[0] == '[' ? host.find(']') + 1 : host.rfind(':'));
+      if (name != "127.0.0.1" && name != "localhost" && name != "[::1]") {
+        answer_json(res, {{"error", "Host must be 127.0.0.1, localhost or [::1]"}}, 403);
+        return httplib::Server::HandlerResponse::Handled;
+      }
+    }
+    // A POST must say it is JSON: a form or text/plain POST from another site's page (no preflight)
+    // is refused, so no page the user visits can drive the solver or start a plan.
+    if (q.method == "POST" && q.get_header_value("Content-Type").rfind("application/json", 0) != 0) {
+      answer_json(res, {{"error", "a POST body must be application/json"}}, 415);
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
   });
   http.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
     try {
@@ -283,6 +318,12 @@ void Server::Impl::routes() {
       answer_json(res, {{"error", std::string("bad request: ") + e.what()}}, 400);
     } catch (const SerialWorker::Busy& e) {
       answer_json(res, {{"error", e.what()}}, 503);
+    } catch (const SerialWorker::Stopping& e) {
+      answer_json(res, {{"error", e.what()}}, 503);
+    } catch (const StaleView& e) {
+      answer_json(res, {{"error", e.what()}}, 409);
+    } catch (const PlanRunning& e) {
+      answer_json(res, {{"error", e.what()}}, 409);
     } catch (const std::exception& e) {
       answer_json(res, {{"error", e.what()}}, 500);
     }
@@ -320,7 +361,7 @@ void Server::Impl::routes() {
   });
   http.Get("/api/exterior.png", [this](const httplib::Request& q, httplib::Response& res) {
     const std::string side = q.has_param("side") ? q.get_param_value("side") : "anterior";
-    const int w = int(number(q, "w", 480)), h = int(number(q, "h", 360));
+    const int w = whole(number(q, "w", 480), "w", 16, 1920), h = whole(number(q, "h", 360), "h", 16, 1080);
     std::vector<Vec3> ports;
     if (q.has_param("ports")) {
       std::stringstream all(q.get_param_value("ports"));
@@ -337,7 +378,9 @@ void Server::Impl::routes() {
   http.Post("/api/pick", [this](const httplib::Request& q, httplib::Response& res) {
     const nlohmann::json b = body_json(q);
     const double x = b.value("x", -1.0), y = b.value("y", -1.0);
-    const std::optional<Vec3> p = on_worker([&] { return session->pick(x, y); });
+    const std::string side = b.value("side", std::string("anterior"));
+    const int w = whole(b.value("w", 480.0), "w", 16, 1920), h = whole(b.value("h", 360.0), "h", 16, 1080);
+    const std::optional<Vec3> p = on_worker([&] { return session->pick(side, w, h, x, y); });
     answer_json(res, {{"skin_point_mm", p ? nlohmann::json{p->x(), p->y(), p->z()} : nlohmann::json()}});
   });
   http.Get("/api/slices.png", [this](const httplib::Request&, httplib::Response& res) {
@@ -351,7 +394,7 @@ void Server::Impl::routes() {
   http.Get("/plan/report.html", [this](const httplib::Request&, httplib::Response& res) {
     const fs::path report = fs::path(opt.out_dir) / "plan" / "report.html";
     std::ifstream is(report, std::ios::binary);
-    if (!is) throw InputError("no plan report yet");
+    if (!is) return answer_json(res, {{"error", "no plan report yet"}}, 404);
     std::stringstream ss;
     ss << is.rdbuf();
     res.set_content(ss.str(), "text/html; charset=utf-8");

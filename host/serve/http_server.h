@@ -2,21 +2,24 @@
 // `pneumo serve SCENE`: one case resident (planning_session.h) behind a local web page and its HTTP
 // API (cpp-httplib). The API, all JSON or PNG:
 //   GET  /                      the page (index.html, app.js, style.css, embedded)
-//   GET  /api/status            settings, solve progress, the last equilibrium's figures, the scene's
-//                               ports and labels
+//   GET  /api/status            settings, solve progress, the last equilibrium's figures, the plan's
+//                               state
 //   POST /api/inflate           {"pressure_mmhg", "wall_young_kpa", "preset"}: a re-inflation from the
 //                               last equilibrium; latest wins (202 with its generation)
 //   GET  /api/scope.png         the laparoscope at a port: sx,sy,sz (skin point, CT as given, mm),
 //                               label or tx,ty,tz (target), ins, fov, obl, roll, yaw, pitch, w, h
 //   GET  /api/exterior.png      side=anterior|left, w, h, ports=x,y,z;x,y,z (marked)
-//   POST /api/pick              {"x", "y"} on the last exterior view → {"skin_point_mm"} (CT as given)
+//   POST /api/pick              {"x", "y", "side", "w", "h"} on the last exterior view → {"skin_point_mm"}
+//                               (CT as given); 409 when that view is no longer the last drawn
 //   GET  /api/slices.png        axial, coronal, sagittal before and after
 //   POST /api/plan              {"ports": [...]}: writes OUT/plan.json and starts `pneumo run` on it
 //                               into OUT/plan (202); its report at GET /plan/report.html
-// Safe by default: it binds 127.0.0.1 unless told otherwise (and warns when not); no file path or
-// scene text is taken from a client (the plan's ports are checked as a scene's); request bodies up
-// to kMaxBodyBytes; at most kMaxRequestsPerSecond requests a second (429 beyond); views queue on one
-// worker (503 when kMaxShortTasks wait); SIGINT and SIGTERM stop it cleanly.
+// Safe by default: it binds 127.0.0.1 unless told otherwise (and warns when not), and then answers
+// only Hosts naming this machine (403) and POSTs declared JSON (415), so other web pages cannot drive
+// it; no file path or scene text is taken from a client (the plan's ports are checked as a scene's);
+// request bodies up to kMaxBodyBytes (413); at most kMaxRequestsPerSecond requests a second (429);
+// views queue on one worker (503 when SerialWorker::kMaxShortTasks wait); SIGINT and SIGTERM stop it
+// cleanly, a plan's run with it.
 #include <atomic>
 #include <cstdint>
 #include <functional>

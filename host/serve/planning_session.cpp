@@ -240,14 +240,17 @@ std::string PlanningSession::exterior_png(const std::string& side, int width, in
     char caption[64];
     std::snprintf(caption, sizeof caption, "%.1f mmHg", shown_pressure_pa_ / units::kPaPerMmHg);
     const AnnotatedView a = annotated_view(image, c.camera, caption, marks);
-    last_exterior_ = Exterior{c.camera, image.depth_mm, warp_mesh_, point_map_};
+    last_exterior_ = Exterior{side, c.camera, image.depth_mm, warp_mesh_, point_map_};
     return encode_png(a.image);
   }
   throw InputError("side must be anterior or left");
 }
 
-std::optional<Vec3> PlanningSession::pick(double x_px, double y_px) {
+std::optional<Vec3> PlanningSession::pick(const std::string& side, int width, int height, double x_px, double y_px) {
   if (!last_exterior_) throw InputError("no exterior view to pick on: ask for one first");
+  if (last_exterior_->side != side || last_exterior_->camera.width != width || last_exterior_->camera.height != height)
+    throw StaleView("the body's view clicked on is no longer the last one drawn (" + side + " " + std::to_string(width) +
+                    "x" + std::to_string(height) + "); ask for it again");
   const ViewCamera& c = last_exterior_->camera;
   if (!(x_px >= 0 && y_px >= 0 && x_px < c.width && y_px < c.height)) return std::nullopt;
   const float depth = last_exterior_->depth_mm[std::size_t(int(y_px) * c.width + int(x_px))];

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,11 @@
 #include "warp/warp.h"
 
 namespace pneumo::serve {
+
+/// A pick on a body view that is no longer the last one drawn (the server answers 409).
+struct StaleView : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 /// What the page may change; everything else comes from the scene file. Absent = as the last
 /// request left it (at first, the scene file's).
@@ -71,10 +77,11 @@ class PlanningSession {
   /// The skin from outside ("anterior" or "left"), after inflation, the given ports marked; the
   /// camera is kept for pick().
   std::string exterior_png(const std::string& side, int width, int height, const std::vector<Vec3>& ports_mm);
-  /// The skin point under pixel (x, y) of the last exterior view, on the CT as given (carried back
-  /// through the deformation); nullopt where the ray met no skin.
-  std::optional<Vec3> pick(double x_px, double y_px);
-  /// Axial, coronal and sagittal slices before and after, through `at_mm` (default: the cavity).
+  /// The skin point under pixel (x, y) of the last exterior view, which must be the one from `side`
+  /// at width × height (StaleView otherwise: the user clicked on another), on the CT as given
+  /// (carried back through the shape that view showed); nullopt where the ray met no skin.
+  std::optional<Vec3> pick(const std::string& side, int width, int height, double x_px, double y_px);
+  /// Axial, coronal and sagittal slices before and after, through the middle of the grid.
   std::string slices_png();
 
   /// The scene as it now stands (the file's text with the changes made), to save as a plan.
@@ -104,6 +111,7 @@ class PlanningSession {
   std::unique_ptr<Volume> deformed_ct_;
   Renderer renderer_;
   struct Exterior {   // the last exterior view: a pick is made on what the user saw
+    std::string side;
     ViewCamera camera;
     std::vector<float> depth_mm;
     std::shared_ptr<const WarpMesh> warp_mesh;    // the shape it showed, kept while picked on

@@ -4,7 +4,7 @@
 // work reach it:
 //  - short tasks (render a view, pick a point on the skin): queued, run in order, each answered
 //    through a future; at most kMaxShortTasks wait, beyond that run() refuses (the server answers
-//    503), so a flood of requests cannot grow memory without bound;
+//    503), so views asked for faster than they render cannot take every request thread;
 //  - long tasks (a re-inflation), one at a time, latest wins: starting one supersedes the one
 //    running, which stops at its next checkpoint, and replaces any still waiting.
 // A long task calls checkpoint() at each solver snapshot: the short tasks waiting are answered
@@ -29,11 +29,16 @@ namespace pneumo::serve {
 
 class SerialWorker {
  public:
-  static constexpr std::size_t kMaxShortTasks = 32;
+  /// Fewer than the server's request threads, so that the status and the controls always find one.
+  static constexpr std::size_t kMaxShortTasks = 6;
 
   /// Thrown by checkpoint() in a long task that a newer one replaced, or when the worker stops.
   struct Superseded : std::exception {
     const char* what() const noexcept override { return "superseded by a newer request"; }
+  };
+  /// Thrown by run() and start() once the worker stops.
+  struct Stopping : std::runtime_error {
+    Stopping() : std::runtime_error("the server is stopping") {}
   };
   /// Thrown by run() when kMaxShortTasks already wait.
   struct Busy : std::runtime_error {
@@ -62,7 +67,7 @@ class SerialWorker {
     std::future<R> result = task->get_future();
     {
       std::lock_guard<std::mutex> lock(m_);
-      if (stop_) throw std::runtime_error("the server is stopping");
+      if (stop_) throw Stopping();
       if (short_.size() >= kMaxShortTasks) throw Busy();
       short_.emplace_back([task] { (*task)(); });
     }
@@ -76,7 +81,7 @@ class SerialWorker {
     uint64_t g;
     {
       std::lock_guard<std::mutex> lock(m_);
-      if (stop_) throw std::runtime_error("the server is stopping");
+      if (stop_) throw Stopping();
       g = ++generation_;
       long_ = std::make_pair(g, std::move(task));
     }

@@ -99,7 +99,7 @@ $("exterior").addEventListener("click", async (ev) => {
   const img = ev.target, r = img.getBoundingClientRect();
   const x = (ev.clientX - r.left) * img.naturalWidth / r.width, y = (ev.clientY - r.top) * img.naturalHeight / r.height;
   try {
-    const j = await post("/api/pick", { x, y });
+    const j = await post("/api/pick", { x, y, side: $("side").value, w: img.naturalWidth, h: img.naturalHeight });
     if (!j.skin_point_mm) { setStatus("no skin under that point", true); return; }
     state.ports.push(j.skin_point_mm);
     state.selected = state.ports.length - 1; state.yaw = 0; state.pitch = 0;
