@@ -113,17 +113,15 @@ class SerialWorker {
   }
 
  private:
+  /// Runs the short tasks waiting when it starts, not those that arrive meanwhile: a steady stream
+  /// of views cannot hold a superseded or stopping solve inside a checkpoint.
   void service() {
-    for (;;) {
-      std::function<void()> f;
-      {
-        std::lock_guard<std::mutex> lock(m_);
-        if (short_.empty()) return;
-        f = std::move(short_.front());
-        short_.pop_front();
-      }
-      f();   // a packaged task: its exception goes to its future
+    std::deque<std::function<void()>> now;
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      now.swap(short_);
     }
+    for (auto& f : now) f();   // packaged tasks: each exception goes to its future
   }
 
   void loop() {
@@ -133,7 +131,7 @@ class SerialWorker {
         std::unique_lock<std::mutex> lock(m_);
         cv_.wait(lock, [&] { return stop_ || !short_.empty() || long_.has_value(); });
         if (stop_ && short_.empty()) return;
-        if (short_.empty()) next.swap(long_);
+        if (!stop_) next.swap(long_);   // its first checkpoint answers the short tasks too
       }
       service();
       if (!next) continue;
