@@ -51,28 +51,31 @@ function showPorts() {
   });
 }
 
-async function inflate(extra) {
-  try {
-    await post("/api/inflate", Object.assign({ pressure_mmhg: +$("pressure").value, wall_young_kpa: +$("wall").value }, extra || {}));
-  } catch (e) { setStatus(e.message, true); }
+// Only the control that changed is sent: the others stay as the server has them (a slider's step
+// must not round the scene's own stiffness into another one).
+async function inflate(change) {
+  try { await post("/api/inflate", change); } catch (e) { setStatus(e.message, true); }
 }
 
 function setStatus(text, error) { $("status").textContent = text; $("status").className = error ? "error" : ""; }
 
 async function poll() {
   try {
-    const s = await (await fetch("/api/status")).json();
+    const r = await fetch("/api/status");
+    if (!r.ok) throw new Error(r.statusText);
+    const s = await r.json();
     let text = s.solving ? `solving: step ${s.step}, ${(+s.pressure_mmhg).toFixed(1)} of ${s.target_pressure_mmhg} mmHg, ${(+s.seconds || 0).toFixed(1)} s`
                          : `${s.converged ? "converged" : "not converged"} at ${(+s.pressure_mmhg).toFixed(1)} mmHg`;
     if (!s.solving && s.anterior_rise_mm !== undefined)
       text += `: rise ${s.anterior_rise_mm.toFixed(1)} mm, cavity ${s.cavity_volume_ml.toFixed(0)} ml`;
     text += ` (${s.preset}, ${s.tetrahedra} tetrahedra)`;
     setStatus(s.error ? "error: " + s.error : text, !!s.error);
-    if (s.shape !== state.shape) {   // a new shape: every image again
+    if (s.shape !== state.shape) {   // a new shape: the views again
       state.shape = s.shape;
       refreshScope(); refreshExterior();
-      if (!s.solving) refreshSlices();
     }
+    if (state.wasSolving !== false && !s.solving) refreshSlices();   // the slices once per equilibrium
+    state.wasSolving = s.solving;
     $("plan-status").textContent = s.plan.state === "none" ? "" :
       s.plan.state === "done" ? "report ready" : "report: " + s.plan.state;
     if (s.plan.state === "done" && !$("plan-status").querySelector("a")) {
@@ -118,7 +121,8 @@ window.addEventListener("mousemove", (ev) => {
 });
 
 for (const id of ["pressure", "wall"]) $(id).addEventListener("input", showOutputs);
-for (const id of ["pressure", "wall"]) $(id).addEventListener("change", () => inflate());
+$("pressure").addEventListener("change", () => inflate({ pressure_mmhg: +$("pressure").value }));
+$("wall").addEventListener("change", () => inflate({ wall_young_kpa: +$("wall").value }));
 $("preset").addEventListener("change", () => inflate({ preset: $("preset").value }));
 $("refine").addEventListener("click", () => { $("preset").value = "balanced"; inflate({ preset: "balanced" }); });
 for (const id of ["roll", "fov", "ins"]) $(id).addEventListener("input", () => { showOutputs(); refreshScope(); });
