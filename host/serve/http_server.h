@@ -3,7 +3,7 @@
 // API (cpp-httplib). The API, all JSON or PNG:
 //   GET  /                      the page (index.html, app.js, style.css, embedded)
 //   GET  /api/status            settings, solve progress, the last equilibrium's figures, the plan's
-//                               state
+//                               state, the scene's ports and the label map's ids with their names
 //   POST /api/inflate           {"pressure_mmhg", "wall_young_kpa", "preset"}: a re-inflation from the
 //                               last equilibrium; latest wins (202 with its generation)
 //   GET  /api/scope.png         the laparoscope at a port: sx,sy,sz (skin point, CT as given, mm),

@@ -11,6 +11,7 @@
 #include "pipeline/exterior_views.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/scene_stages.h"
+#include "pipeline/warp_stage.h"
 #include "render/image_out.h"
 #include "render/poses.h"
 #include "report/slices.h"
@@ -47,7 +48,9 @@ PlanningSession::PlanningSession(nlohmann::json scene_json, std::string scene_pa
              {"step", 0},
              {"shape", 0},
              {"tetrahedra", int64_t(sim_.mesh.tets.size())},
-             {"renderer", renderer_.describe()}};
+             {"renderer", renderer_.describe()},
+             {"ports", scene_ports()},
+             {"labels", label_list()}};
   }
   refresh_shape(sim_, scene_, x_, 0.0);
 }
@@ -59,6 +62,36 @@ InflateRequest PlanningSession::merged(const InflateRequest& r) const {
   if (r.wall_young_kpa) m.wall_young_kpa = r.wall_young_kpa;
   if (r.preset) m.preset = r.preset;
   return m;
+}
+
+nlohmann::json PlanningSession::scene_ports() const {
+  nlohmann::json list = nlohmann::json::array();
+  for (const Port& p : scene_.render.ports) {
+    nlohmann::json j = {{"name", p.name},
+                        {"skin_point_mm", {p.skin_point_mm.x(), p.skin_point_mm.y(), p.skin_point_mm.z()}},
+                        {"insertion_mm", p.insertion_mm},
+                        {"fov_deg", p.optics.fov_deg},
+                        {"oblique_deg", p.optics.oblique_deg},
+                        {"roll_deg", p.optics.roll_deg}};
+    if (p.target_label) j["target_label"] = *p.target_label;
+    if (p.target_mm) j["target_mm"] = {p.target_mm->x(), p.target_mm->y(), p.target_mm->z()};
+    list.push_back(j);
+  }
+  return list;
+}
+
+nlohmann::json PlanningSession::label_list() const {
+  // The ids the label map holds, named from inputs.label_names when the scene gives it.
+  const std::map<int, std::string> names = scene_label_names(scene_);
+  std::vector<uint8_t> present(65536, 0);
+  for (uint16_t l : sim_.roles.label) present[l] = 1;
+  nlohmann::json list = nlohmann::json::array();
+  for (int id = 1; id < 65536; ++id) {
+    if (!present[std::size_t(id)]) continue;
+    const auto n = names.find(id);
+    list.push_back({{"id", id}, {"name", n == names.end() ? "" : n->second}});
+  }
+  return list;
 }
 
 Scene PlanningSession::scene_for(const InflateRequest& request) const {

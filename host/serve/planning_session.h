@@ -95,6 +95,8 @@ class PlanningSession {
   /// Warps sim's CT through shape x and uploads it: the views' volume and point map from then on.
   void refresh_shape(const Simulation& sim, const Scene& scene, const std::vector<Vec3>& x, double pressure_pa);
   InflateRequest merged(const InflateRequest& r) const;                 // r over settings_
+  nlohmann::json scene_ports() const;   // the scene's ports, for the page to start from
+  nlohmann::json label_list() const;    // the label map's ids with their names, for the targets
   PointMapFn to_deformed() const;
 
   nlohmann::json scene_json_;

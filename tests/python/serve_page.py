@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """`pneumo serve`'s page in a real browser (issue 22, item 7): headless Chromium driven by Selenium
-opens the page, waits for the first equilibrium, clicks the skin on the body's view to place a port,
+opens the page (the scene's ports listed), waits for the first equilibrium, clicks the skin on the
+body's view to place a port,
 waits for the laparoscope's view, moves the pressure slider down, waits for the view to change and
 the status to report the new pressure, and saves a screenshot.
 
@@ -70,11 +71,14 @@ try:
     exterior = driver.find_element(By.ID, "exterior")
     wait_for("the body's view", lambda: driver.execute_script(
         "return arguments[0].complete && arguments[0].naturalWidth > 0", exterior), 60)
+    ports_before = len(driver.find_elements(By.CSS_SELECTOR, "#port-list button"))   # the scene's own
     exterior.click()   # the middle of the anterior view: the skin in front of the abdomen
-    wait_for("a port placed on the skin", lambda: driver.find_elements(By.CSS_SELECTOR, "#port-list button"), 60)
+    wait_for("a port placed on the skin", lambda: len(driver.find_elements(
+        By.CSS_SELECTOR, "#port-list button")) == ports_before + 1, 60)
     scope = driver.find_element(By.ID, "scope")
-    wait_for("the laparoscope's view", lambda: driver.execute_script(
-        "return arguments[0].complete && arguments[0].naturalWidth === 480", scope), 60)
+    view_settled = ("return !state.viewBusy && !state.viewAgain && state.selected === arguments[1] && "
+                    "arguments[0].complete && arguments[0].naturalWidth === 480")
+    wait_for("the laparoscope's view from the new port", lambda: driver.execute_script(view_settled, scope, ports_before), 60)
     before = scope.screenshot_as_png
 
     slider = driver.find_element(By.ID, "pressure")
@@ -89,7 +93,7 @@ try:
     wait_for(f"the status at {pressure}.0 mmHg, converged",
              lambda: status.text.startswith(f"converged at {pressure}.0"), 240)
     wait_for("the laparoscope's view changed with the pressure",
-             lambda: driver.execute_script("return arguments[0].complete", scope) and scope.screenshot_as_png != before, 60)
+             lambda: driver.execute_script(view_settled, scope, ports_before) and scope.screenshot_as_png != before, 60)
     if screenshot:
         driver.save_screenshot(screenshot)
     print(f"ok: port placed, view changed, status '{status.text}'")

@@ -2,7 +2,40 @@
 // renders every image; this file sends the controls' values and shows what comes back.
 "use strict";
 const $ = (id) => document.getElementById(id);
+// A port: its skin point on the CT as given, its target (an organ label, or a point from the scene)
+// and its scope's optics; the controls show and change the selected one.
 const state = { ports: [], selected: -1, yaw: 0, pitch: 0, shape: -1, viewBusy: false, viewAgain: false };
+const OPTICS = { ins: "insertion_mm", fov: "fov_deg", oblique: "oblique_deg", roll: "roll_deg" };
+
+function newPort(name, skin) {
+  const p = { name, skin_point_mm: skin, target_label: +$("target").value || null };
+  for (const [id, key] of Object.entries(OPTICS)) p[key] = +$(id).value;
+  return p;
+}
+
+function selectPort(k) {
+  state.selected = k; state.yaw = 0; state.pitch = 0;
+  const p = state.ports[k];
+  for (const [id, key] of Object.entries(OPTICS)) $(id).value = p[key];
+  $("target").value = p.target_label !== null && p.target_label !== undefined ? p.target_label : "point";
+  showOutputs(); showPorts(); refreshScope();
+}
+
+function fillTargets(labels, ports) {
+  const t = $("target");
+  for (const l of labels) {
+    const o = document.createElement("option");
+    o.value = l.id; o.textContent = l.id + (l.name ? " " + l.name : "");
+    t.appendChild(o);
+  }
+  if (ports.some((p) => p.target_mm)) {
+    const o = document.createElement("option");
+    o.value = "point"; o.textContent = "the scene's point";
+    t.appendChild(o);
+  }
+  const liver = labels.find((l) => l.id === 5);
+  if (liver) t.value = 5;
+}
 
 async function post(path, body) {
   const r = await fetch(path, { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
@@ -12,11 +45,11 @@ async function post(path, body) {
 }
 
 function scopeUrl() {
-  const p = state.ports[state.selected];
-  const q = new URLSearchParams({
-    sx: p[0], sy: p[1], sz: p[2], label: $("target").value, ins: $("ins").value, fov: $("fov").value,
-    obl: $("oblique").value, roll: $("roll").value, yaw: state.yaw, pitch: state.pitch, w: 480, h: 360,
-    n: Date.now() });
+  const p = state.ports[state.selected], s = p.skin_point_mm;
+  const q = new URLSearchParams({ sx: s[0], sy: s[1], sz: s[2], ins: p.insertion_mm, fov: p.fov_deg, obl: p.oblique_deg,
+                                  roll: p.roll_deg, yaw: state.yaw, pitch: state.pitch, w: 480, h: 360, n: Date.now() });
+  if (p.target_label) q.set("label", p.target_label);
+  else { q.set("tx", p.target_mm[0]); q.set("ty", p.target_mm[1]); q.set("tz", p.target_mm[2]); }
   return "/api/scope.png?" + q;
 }
 
@@ -33,7 +66,7 @@ function refreshScope() {
 }
 
 function refreshExterior() {
-  const ports = state.ports.map((p) => p.map((v) => v.toFixed(1)).join(",")).join(";");
+  const ports = state.ports.map((p) => p.skin_point_mm.map((v) => v.toFixed(1)).join(",")).join(";");
   $("exterior").src = "/api/exterior.png?" + new URLSearchParams({ side: $("side").value, w: 480, h: 360, ports, n: Date.now() });
 }
 
@@ -44,9 +77,9 @@ function showPorts() {
   list.textContent = "";
   state.ports.forEach((p, k) => {
     const b = document.createElement("button");
-    b.textContent = "port " + (k + 1);
+    b.textContent = p.name;
     b.className = k === state.selected ? "selected" : "";
-    b.onclick = () => { state.selected = k; state.yaw = 0; state.pitch = 0; showPorts(); refreshScope(); };
+    b.onclick = () => selectPort(k);
     list.appendChild(b);
   });
 }
@@ -83,11 +116,14 @@ async function poll() {
       a.href = "/plan/report.html"; a.target = "_blank"; a.textContent = " open";
       $("plan-status").appendChild(a);
     }
-    if (state.first === undefined) {
+    if (state.first === undefined) {   // the scene's settings, labels and ports to start from
       state.first = true;
       $("pressure").value = s.target_pressure_mmhg; $("wall").value = s.wall_young_kpa;
       if (s.preset !== "none") $("preset").value = s.preset;
-      showOutputs();
+      fillTargets(s.labels, s.ports);
+      state.ports = s.ports.map((p) => Object.assign({ target_label: null }, p));
+      showOutputs(); showPorts();
+      if (state.ports.length) selectPort(0);
     }
   } catch (e) { setStatus("the server does not answer", true); }
   setTimeout(poll, 400);
@@ -104,9 +140,9 @@ $("exterior").addEventListener("click", async (ev) => {
   try {
     const j = await post("/api/pick", { x, y, side: $("side").value, w: img.naturalWidth, h: img.naturalHeight });
     if (!j.skin_point_mm) { setStatus("no skin under that point", true); return; }
-    state.ports.push(j.skin_point_mm);
-    state.selected = state.ports.length - 1; state.yaw = 0; state.pitch = 0;
-    showPorts(); refreshScope(); refreshExterior();
+    state.ports.push(newPort("port " + (state.ports.length + 1), j.skin_point_mm));
+    selectPort(state.ports.length - 1);
+    refreshExterior();
   } catch (e) { setStatus(e.message, true); }
 });
 
@@ -125,13 +161,26 @@ $("pressure").addEventListener("change", () => inflate({ pressure_mmhg: +$("pres
 $("wall").addEventListener("change", () => inflate({ wall_young_kpa: +$("wall").value }));
 $("preset").addEventListener("change", () => inflate({ preset: $("preset").value }));
 $("refine").addEventListener("click", () => { $("preset").value = "balanced"; inflate({ preset: "balanced" }); });
-for (const id of ["roll", "fov", "ins"]) $(id).addEventListener("input", () => { showOutputs(); refreshScope(); });
-for (const id of ["oblique", "target"]) $(id).addEventListener("change", refreshScope);
+// The optics and the target belong to the selected port.
+for (const [id, key] of Object.entries(OPTICS))
+  $(id).addEventListener("input", () => {
+    if (state.selected >= 0) state.ports[state.selected][key] = +$(id).value;
+    showOutputs(); refreshScope();
+  });
+$("target").addEventListener("change", () => {
+  if (state.selected < 0 || $("target").value === "point") return;
+  state.ports[state.selected].target_label = +$("target").value;
+  refreshScope();
+});
 $("side").addEventListener("change", refreshExterior);
 $("plan").addEventListener("click", async () => {
   if (!state.ports.length) { setStatus("place a port on the skin first", true); return; }
-  const ports = state.ports.map((p) => ({ skin_point_mm: p, target_label: +$("target").value, insertion_mm: +$("ins").value,
-                                          fov_deg: +$("fov").value, oblique_deg: +$("oblique").value, roll_deg: +$("roll").value }));
+  const ports = state.ports.map((p) => {
+    const q = { skin_point_mm: p.skin_point_mm, insertion_mm: p.insertion_mm, fov_deg: p.fov_deg,
+                oblique_deg: p.oblique_deg, roll_deg: p.roll_deg };
+    if (p.target_label) q.target_label = p.target_label; else q.target_mm = p.target_mm;
+    return q;
+  });
   try { await post("/api/plan", { ports }); } catch (e) { setStatus(e.message, true); }
 });
 poll();
