@@ -1,0 +1,385 @@
+#include "plan/port_ranking.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <optional>
+
+#include "core/error.h"
+#include "plan/distance_map.h"
+#include "roles/anatomical_axes.h"
+
+namespace pneumo {
+
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+
+/// Exposed target points a candidate's path may aim at when the path to the centroid is closed.
+constexpr std::size_t kAimTries = 48;
+
+/// 0 at a, rising linearly to 1 at b (a < b), 1 beyond.
+double ramp_up(double v, double a, double b) { return std::clamp((v - a) / (b - a), 0.0, 1.0); }
+/// 1 over [b, c], linear to 0 at a and at d.
+double plateau(double v, double a, double b, double c, double d) {
+  return std::min(ramp_up(v, a, b), 1.0 - ramp_up(v, c, d));
+}
+
+/// Voxel lookups along straight lines through the grid.
+struct Grid {
+  const uint16_t* labels;
+  const Geometry& g;
+  double step_mm;
+
+  /// The linear index of the voxel holding `p`, -1 outside the grid.
+  int64_t voxel(const Vec3& p) const {
+    const Vec3 ijk = g.to_index(p);
+    const int64_t i = std::llround(ijk.x()), j = std::llround(ijk.y()), k = std::llround(ijk.z());
+    if (i < 0 || j < 0 || k < 0 || i >= g.dims[0] || j >= g.dims[1] || k >= g.dims[2]) return -1;
+    return g.linear_index(i, j, k);
+  }
+  /// -1 outside the grid (air: what lies beyond the grown grid is outside the body).
+  int label_at(const Vec3& p) const {
+    const int64_t v = voxel(p);
+    return v < 0 ? -1 : int(labels[v]);
+  }
+};
+
+/// What the straight path from the skin point towards the aim point meets.
+struct PathWalk {
+  PortProblem problem = PortProblem::None;
+  int blocking_label = 0;
+  std::vector<int> wall_labels;   // the labels crossed between the skin and the gas (distinct)
+  Vec3 gas_entry = Vec3::Zero(), target_hit = Vec3::Zero();
+  double wall_mm = 0.0;
+};
+
+PathWalk walk_path(const Grid& grid, const Vec3& skin, const Vec3& aim, int target, int gas, double max_wall_mm) {
+  PathWalk w;
+  const Vec3 dir = (aim - skin).normalized();
+  const double length = (aim - skin).norm();
+  const double block_mm = kBlockToleranceVoxels * grid.g.spacing_mm.maxCoeff();
+  bool in_gas = false;
+  double tissue_run_mm = 0.0;
+  int tissue_label = 0;
+  for (double t = 0.0; t <= length + grid.step_mm; t += grid.step_mm) {
+    const Vec3 p = skin + std::min(t, length) * dir;
+    const int l = grid.label_at(p);
+    if (!in_gas) {
+      if (l == gas) {
+        in_gas = true;
+        w.gas_entry = p;
+        w.wall_mm = t;
+        continue;
+      }
+      if (t > max_wall_mm) {
+        w.problem = PortProblem::WallTooThick;
+        return w;
+      }
+      if (l == target) {
+        w.problem = PortProblem::NoGas;   // the target lies against the wall here
+        return w;
+      }
+      if (l > 0 && std::find(w.wall_labels.begin(), w.wall_labels.end(), l) == w.wall_labels.end())
+        w.wall_labels.push_back(l);
+      continue;
+    }
+    if (l == target) {
+      w.target_hit = p;
+      return w;
+    }
+    if (l == gas) {
+      tissue_run_mm = 0.0;
+      continue;
+    }
+    if (tissue_run_mm == 0.0) tissue_label = std::max(l, 0);
+    tissue_run_mm += grid.step_mm;
+    if (tissue_run_mm > block_mm) {
+      w.problem = PortProblem::Blocked;
+      w.blocking_label = tissue_label;
+      return w;
+    }
+  }
+  // The aim point is a target voxel: a walk that reached it in gas has hit it above.
+  w.problem = in_gas ? PortProblem::Blocked : PortProblem::NoGas;
+  return w;
+}
+
+/// The fraction of `samples` (target surface points) a scope at `eye` looking along `axis` sees:
+/// within the half angle of its field of view, and the first non-gas voxel on the way is the target.
+double visible_fraction(const Grid& grid, const Vec3& eye, const Vec3& axis, double half_fov_rad,
+                        const std::vector<Vec3>& samples, int target, int gas) {
+  if (samples.empty()) return 0.0;
+  const double cos_half = std::cos(half_fov_rad);
+  int64_t seen = 0;
+  for (const Vec3& q : samples) {
+    const Vec3 v = q - eye;
+    const double d = v.norm();
+    if (d < 1e-9) {
+      ++seen;
+      continue;
+    }
+    const Vec3 u = v / d;
+    if (u.dot(axis) < cos_half) continue;
+    for (double t = 0.0; t <= d + grid.step_mm; t += grid.step_mm) {
+      const int l = grid.label_at(eye + std::min(t, d) * u);
+      if (l == gas) continue;
+      if (l == target) ++seen;
+      break;
+    }
+  }
+  return double(seen) / double(samples.size());
+}
+
+/// The labelled voxel nearest `p` within `radius_mm` (0 when none): which structure the clearance names.
+int nearest_labelled(const Grid& grid, const std::vector<uint8_t>& obstacle, const Vec3& p, double radius_mm) {
+  const Geometry& g = grid.g;
+  const Vec3 c = g.to_index(p);
+  int best = 0;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  std::array<int64_t, 3> lo{}, hi{};
+  for (int a = 0; a < 3; ++a) {
+    const double r = radius_mm / g.spacing_mm[a] + 1.0;
+    lo[std::size_t(a)] = std::max<int64_t>(0, int64_t(std::floor(c[a] - r)));
+    hi[std::size_t(a)] = std::min<int64_t>(g.dims[std::size_t(a)] - 1, int64_t(std::ceil(c[a] + r)));
+  }
+  for (int64_t k = lo[2]; k <= hi[2]; ++k)
+    for (int64_t j = lo[1]; j <= hi[1]; ++j)
+      for (int64_t i = lo[0]; i <= hi[0]; ++i) {
+        const int64_t n = g.linear_index(i, j, k);
+        if (!obstacle[std::size_t(n)]) continue;
+        const Vec3 d((double(i) - c.x()) * g.spacing_mm.x(), (double(j) - c.y()) * g.spacing_mm.y(),
+                     (double(k) - c.z()) * g.spacing_mm.z());
+        if (d.squaredNorm() < best_d2) {
+          best_d2 = d.squaredNorm();
+          best = grid.labels[n];
+        }
+      }
+  return best;
+}
+
+}  // namespace
+
+const char* port_problem_name(PortProblem p) {
+  switch (p) {
+    case PortProblem::None: return "none";
+    case PortProblem::NoGas: return "no_gas";
+    case PortProblem::WallTooThick: return "wall_too_thick";
+    case PortProblem::CrossesOrgan: return "crosses_organ";
+    case PortProblem::Blocked: return "blocked";
+  }
+  return "?";
+}
+
+double visibility_term(double f) { return std::clamp(f, 0.0, 1.0); }
+double clearance_term(double mm) { return ramp_up(mm, 0.0, 20.0); }
+double distance_term(double mm) { return plateau(mm, 60.0, 180.0, 240.0, 300.0); }
+double elevation_term(double deg) { return plateau(deg, 0.0, 30.0, 60.0, 90.0); }
+double spacing_term(double mm) { return ramp_up(mm, 20.0, 50.0); }
+double manipulation_term(double deg) { return plateau(deg, 15.0, 45.0, 75.0, 105.0); }
+
+PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometry& g, const PortRankOptions& o) {
+  if (o.target_label <= 0 || o.target_label > 65535) throw InputError("the target label must be 1 to 65535");
+  if (o.target_label == o.gas_label)
+    throw InputError("the target label " + std::to_string(o.target_label) + " is the cavity's own label");
+  if (!(o.grid_mm >= 2.0 && o.grid_mm <= 200.0)) throw InputError("the candidates' grid must be 2 to 200 mm");
+  if (!(o.fov_deg > 0.0 && o.fov_deg < 180.0)) throw InputError("fov_deg must be above 0 and below 180");
+  const int target = o.target_label, gas = o.gas_label;
+  const int64_t n = g.voxel_count();
+  PortRanking r;
+
+  // The target: its voxels, centroid, the voxel nearest the centroid, evenly spread surface samples.
+  Vec3 sum = Vec3::Zero();
+  std::vector<int64_t> surface, exposed;   // the target's boundary voxels; those touching the gas
+  const std::array<int64_t, 3> stride{1, g.dims[0], g.dims[0] * g.dims[1]};
+  for (int64_t k = 0; k < g.dims[2]; ++k)
+    for (int64_t j = 0; j < g.dims[1]; ++j)
+      for (int64_t i = 0; i < g.dims[0]; ++i) {
+        const int64_t v = g.linear_index(i, j, k);
+        if (labels[v] != target) continue;
+        ++r.target_voxels;
+        sum += g.to_world(Vec3(double(i), double(j), double(k)));
+        const std::array<int64_t, 3> idx{i, j, k};
+        bool inner = true;
+        for (int a = 0; a < 3 && inner; ++a)
+          for (int s : {-1, 1}) {
+            const int64_t q = idx[std::size_t(a)] + s;
+            if (q < 0 || q >= g.dims[std::size_t(a)] || labels[v + s * stride[std::size_t(a)]] != target) {
+              inner = false;
+              break;
+            }
+          }
+        if (inner) continue;
+        surface.push_back(v);
+        for (int a = 0; a < 3; ++a)
+          for (int s : {-1, 1}) {
+            const int64_t q = idx[std::size_t(a)] + s;
+            if (q >= 0 && q < g.dims[std::size_t(a)] && labels[v + s * stride[std::size_t(a)]] == gas) {
+              exposed.push_back(v);
+              a = 3;
+              break;
+            }
+          }
+      }
+  if (r.target_voxels == 0)
+    throw InputError("label " + std::to_string(target) + " holds no voxel in the deformed labels: no target to rank ports for");
+  r.target_centroid_mm = sum / double(r.target_voxels);
+  const auto world_of = [&](int64_t v) {
+    const int64_t i = v % g.dims[0], j = (v / g.dims[0]) % g.dims[1], k = v / (g.dims[0] * g.dims[1]);
+    return g.to_world(Vec3(double(i), double(j), double(k)));
+  };
+  {
+    double best = std::numeric_limits<double>::infinity();
+    for (int64_t v : surface) {   // the nearest surface voxel; the centroid itself when it lies inside
+      const double d = (world_of(v) - r.target_centroid_mm).squaredNorm();
+      if (d < best) best = d, r.target_aim_mm = world_of(v);
+    }
+    const Grid probe{labels, g, 0.0};
+    if (probe.label_at(r.target_centroid_mm) == target) r.target_aim_mm = r.target_centroid_mm;
+  }
+  r.exposed_voxels = int64_t(exposed.size());
+  // The points an instrument may aim at: the exposed surface, nearest the centroid first (at most
+  // kAimTries of them, evenly spread), so a path reaches the target's middle where it can.
+  std::vector<Vec3> aims;
+  {
+    const std::size_t count = std::min<std::size_t>(exposed.size(), kAimTries);
+    for (std::size_t s = 0; s < count; ++s) aims.push_back(world_of(exposed[s * exposed.size() / count]));
+  }
+  std::vector<Vec3> samples;
+  {
+    const std::size_t count = std::min<std::size_t>(surface.size(), std::size_t(std::max(o.target_samples, 1)));
+    for (std::size_t s = 0; s < count; ++s) samples.push_back(world_of(surface[s * surface.size() / count]));
+  }
+
+  // The candidates: the anterior skin, one point per grid_mm laterally and cranio-caudally.
+  const SliceFrame f = slice_frame(g);
+  const int64_t step_lat = std::max<int64_t>(1, std::llround(o.grid_mm / f.h_lat));
+  const int64_t step_si = std::max<int64_t>(1, std::llround(o.grid_mm / f.h_si));
+  std::vector<Vec3> skins;
+  for (int64_t s = step_si / 2; s < f.n_si; s += step_si)
+    for (int64_t l = step_lat / 2; l < f.n_lat; l += step_lat)
+      for (int64_t A = f.n_ap - 1; A >= 0; --A) {
+        const int64_t a = f.ant(A);
+        const int64_t v = f.index(l, a, s);
+        if (ct_hu[v] < o.skin_hu) continue;
+        std::array<int64_t, 3> idx{};
+        idx[std::size_t(f.lat)] = l, idx[std::size_t(f.ap)] = a, idx[std::size_t(f.si)] = s;
+        skins.push_back(g.to_world(Vec3(double(idx[0]), double(idx[1]), double(idx[2]))));
+        break;
+      }
+  if (skins.empty()) throw InputError("no skin found (no voxel at or above " + std::to_string(o.skin_hu) + " HU)");
+
+  // Pass 1: the paths. The wall's own layers are the labels that most trocars reaching the gas cross.
+  const Grid grid{labels, g, 0.5 * g.spacing_mm.minCoeff()};
+  std::vector<PathWalk> walks(skins.size());
+  std::vector<Vec3> aim_of(skins.size(), r.target_aim_mm);
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int64_t c = 0; c < int64_t(skins.size()); ++c) {
+    // The exposed points by their angle from the line to the centroid: the first open path wins; a
+    // candidate with none keeps the problem of the path to the centroid.
+    const Vec3 skin = skins[std::size_t(c)];
+    const Vec3 to_centre = (r.target_aim_mm - skin).normalized();
+    std::vector<std::pair<double, std::size_t>> order;
+    for (std::size_t a = 0; a < aims.size(); ++a) order.push_back({-(aims[a] - skin).normalized().dot(to_centre), a});
+    std::sort(order.begin(), order.end());
+    PathWalk& w = walks[std::size_t(c)];
+    w = walk_path(grid, skin, r.target_aim_mm, target, gas, o.max_wall_mm);
+    for (std::size_t t = 0; w.problem != PortProblem::None && t < order.size() && t < kAimTries; ++t) {
+      PathWalk tried = walk_path(grid, skin, aims[order[t].second], target, gas, o.max_wall_mm);
+      if (tried.problem == PortProblem::None) {
+        w = std::move(tried);
+        aim_of[std::size_t(c)] = aims[order[t].second];
+      }
+    }
+  }
+  std::map<int, int> crossed;
+  int reaching = 0;
+  for (const PathWalk& w : walks) {
+    if (w.problem != PortProblem::None) continue;
+    ++reaching;
+    for (int l : w.wall_labels) ++crossed[l];
+  }
+  for (const auto& [l, count] : crossed)
+    if (2 * count >= reaching) r.wall_layer_labels.push_back(l);
+  const auto is_wall_layer = [&](int l) {
+    return std::find(r.wall_layer_labels.begin(), r.wall_layer_labels.end(), l) != r.wall_layer_labels.end();
+  };
+
+  // The obstacles: every other labelled structure; their distance map gives each path's clearance.
+  std::vector<uint8_t> obstacle(std::size_t(n), 0);
+  for (int64_t v = 0; v < n; ++v) {
+    const int l = labels[v];
+    obstacle[std::size_t(v)] = l != 0 && l != target && l != gas && !is_wall_layer(l);
+  }
+  const std::vector<float> clearance = distance_to_mask_mm(obstacle, g);
+
+  // Pass 2: the terms of every candidate whose path is open.
+  const double half_fov = 0.5 * o.fov_deg / kDeg;
+  r.candidates.resize(skins.size());
+#pragma omp parallel for schedule(dynamic, 2)
+  for (int64_t ci = 0; ci < int64_t(skins.size()); ++ci) {
+    PortCandidate& c = r.candidates[std::size_t(ci)];
+    const PathWalk& w = walks[std::size_t(ci)];
+    c.skin_mm = skins[std::size_t(ci)];
+    c.problem = w.problem;
+    c.blocking_label = w.blocking_label;
+    if (c.feasible())
+      for (int l : w.wall_labels)
+        if (!is_wall_layer(l)) {
+          c.problem = PortProblem::CrossesOrgan;
+          c.blocking_label = l;
+          break;
+        }
+    c.aim_mm = aim_of[std::size_t(ci)];
+    const Vec3 axis = (c.aim_mm - c.skin_mm).normalized();
+    c.elevation_deg = std::asin(std::min(1.0, std::abs(axis.y()))) * kDeg;   // y: anterior, the vertical when supine
+    c.wall_mm = w.wall_mm;
+    if (!c.feasible()) continue;
+    c.gas_entry_mm = w.gas_entry;
+    c.skin_to_target_mm = (w.target_hit - c.skin_mm).norm();
+    const double in_gas = (w.target_hit - w.gas_entry).norm();
+    const Vec3 eye = w.gas_entry + std::min(o.eye_depth_mm, 0.5 * in_gas) * axis;
+    c.visible_fraction = visible_fraction(grid, eye, axis, half_fov, samples, target, gas);
+    // Clearance along the path in the gas, short of the target's own neighbourhood (the last 10 mm,
+    // where the instrument works on the target and touches what lies beside it).
+    c.clearance_mm = std::numeric_limits<double>::infinity();
+    Vec3 closest = w.gas_entry;
+    for (double t = 0.0; t <= std::max(0.0, in_gas - 10.0); t += grid.step_mm) {
+      const Vec3 p = w.gas_entry + t * axis;
+      const int64_t v = grid.voxel(p);
+      if (v < 0) continue;
+      if (clearance[std::size_t(v)] < c.clearance_mm) c.clearance_mm = clearance[std::size_t(v)], closest = p;
+    }
+    if (std::isfinite(c.clearance_mm)) c.nearest_label = nearest_labelled(grid, obstacle, closest, c.clearance_mm + 1.0);
+    // Triangulation with the ports already placed.
+    for (const Vec3& other : o.other_ports_mm) {
+      const double d = (other - c.skin_mm).norm();
+      c.spacing_mm = std::isnan(c.spacing_mm) ? d : std::min(c.spacing_mm, d);
+      const Vec3 a = (c.skin_mm - c.aim_mm).normalized(), b = (other - c.aim_mm).normalized();
+      const double angle = std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * kDeg;
+      if (std::isnan(c.manipulation_deg) || manipulation_term(angle) > manipulation_term(c.manipulation_deg))
+        c.manipulation_deg = angle;
+    }
+    c.t_visibility = visibility_term(c.visible_fraction);
+    c.t_clearance = clearance_term(c.clearance_mm);
+    c.t_distance = distance_term(c.skin_to_target_mm);
+    c.t_elevation = elevation_term(c.elevation_deg);
+    const PortRankWeights& wt = o.weights;
+    double num = wt.visibility * c.t_visibility + wt.clearance * c.t_clearance + wt.distance * c.t_distance +
+                 wt.elevation * c.t_elevation;
+    double den = wt.visibility + wt.clearance + wt.distance + wt.elevation;
+    if (!o.other_ports_mm.empty()) {
+      c.t_triangulation = spacing_term(c.spacing_mm) * manipulation_term(c.manipulation_deg);
+      num += wt.triangulation * c.t_triangulation;
+      den += wt.triangulation;
+    }
+    c.score = den > 0.0 ? num / den : 0.0;
+  }
+  std::stable_sort(r.candidates.begin(), r.candidates.end(), [](const PortCandidate& a, const PortCandidate& b) {
+    if (a.feasible() != b.feasible()) return a.feasible();
+    return a.score > b.score;
+  });
+  return r;
+}
+
+}  // namespace pneumo
