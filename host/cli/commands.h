@@ -21,5 +21,6 @@ Run add_run(CLI::App& app);
 Run add_warp(CLI::App& app);
 Run add_bench(CLI::App& app);
 Run add_serve(CLI::App& app);
+Run add_ports(CLI::App& app);
 
 }  // namespace pneumo::cli

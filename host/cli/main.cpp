@@ -55,6 +55,7 @@ int main(int argc, char** argv) {
   add(cli::add_warp);
   add(cli::add_render);
   add(cli::add_run);
+  add(cli::add_ports);
   add(cli::add_serve);
   add(cli::add_bench);
 

@@ -26,7 +26,9 @@ Frame grid_frame(const Geometry& g) {
 
 double camera_distance(double radius) { return radius / std::sin(kExteriorFovDeg * kPi / 360.0); }
 
-void ring(RgbImage& im, double cx, double cy, double r_in, double r_out, Rgb c) {
+}  // namespace
+
+void draw_ring(RgbImage& im, double cx, double cy, double r_in, double r_out, Rgb c) {
   for (int y = int(std::floor(cy - r_out)); y <= int(std::ceil(cy + r_out)); ++y)
     for (int x = int(std::floor(cx - r_out)); x <= int(std::ceil(cx + r_out)); ++x) {
       const double d = std::hypot(x + 0.5 - cx, y + 0.5 - cy);
@@ -34,7 +36,15 @@ void ring(RgbImage& im, double cx, double cy, double r_in, double r_out, Rgb c) 
     }
 }
 
-}  // namespace
+std::optional<Eigen::Vector2d> visible_on_view(const RenderImage& im, const ViewCamera& camera, const Vec3& point_mm) {
+  const std::optional<Eigen::Vector2d> p = camera.project(point_mm);
+  if (!p || p->x() < 0 || p->y() < 0 || p->x() >= im.width || p->y() >= im.height) return std::nullopt;
+  const std::size_t pixel = std::size_t(int(p->y())) * im.width + std::size_t(int(p->x()));
+  const double surface = im.depth_mm[pixel];
+  const double along = (point_mm - camera.position_mm).norm();
+  if (std::isfinite(surface) && along > surface + kMarkDepthToleranceMm) return std::nullopt;   // behind the body
+  return p;
+}
 
 std::vector<ExteriorCamera> exterior_cameras(const Geometry& g, int width, int height) {
   const Frame f = grid_frame(g);
@@ -68,14 +78,10 @@ AnnotatedView annotated_view(const RenderImage& im, const ViewCamera& camera, co
   const int scale = im.width >= 400 ? 2 : 1;
   const double r = 4.0 * scale;
   for (const SkinMark& m : marks) {
-    const std::optional<Eigen::Vector2d> p = camera.project(m.point_mm);
-    if (!p || p->x() < 0 || p->y() < 0 || p->x() >= im.width || p->y() >= im.height) continue;
-    const std::size_t pixel = std::size_t(int(p->y())) * im.width + std::size_t(int(p->x()));
-    const double surface = im.depth_mm[pixel];
-    const double along = (m.point_mm - camera.position_mm).norm();
-    if (std::isfinite(surface) && along > surface + kMarkDepthToleranceMm) continue;   // behind the body
-    ring(out.image, p->x(), p->y(), r - scale, r + scale, Rgb{0, 0, 0});                // a dark rim: readable on any tone
-    ring(out.image, p->x(), p->y(), r - 0.5 * scale, r + 0.5 * scale, kMarkColour);
+    const std::optional<Eigen::Vector2d> p = visible_on_view(im, camera, m.point_mm);
+    if (!p) continue;
+    draw_ring(out.image, p->x(), p->y(), r - scale, r + scale, Rgb{0, 0, 0});                // a dark rim: readable on any tone
+    draw_ring(out.image, p->x(), p->y(), r - 0.5 * scale, r + 0.5 * scale, kMarkColour);
     draw_text(out.image, int(p->x() + r + 2 * scale), int(p->y()) - text_height_px(scale) / 2, m.name, kMarkColour,
               scale);
     out.marked.push_back(m.name);

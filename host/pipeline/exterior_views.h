@@ -3,6 +3,7 @@
 // -500 HU), from in front and from the left, before and after inflation side by side, each port
 // marked where its skin point lies. The same cameras frame both panels, so the rise of the dome is
 // read by comparing them.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,13 @@ struct SkinMark {
 /// How far behind the surface a ray found a mark may lie and still be drawn (mm): a skin point
 /// given a few mm inside the skin is marked; one on the far side of the body (tens of cm) is not.
 inline constexpr double kMarkDepthToleranceMm = 20.0;
+
+/// Where `point_mm` shows on a rendered view: its pixel when it projects into the image and lies no
+/// deeper than kMarkDepthToleranceMm behind the first surface along that pixel's ray; nullopt else.
+std::optional<Eigen::Vector2d> visible_on_view(const RenderImage& image, const ViewCamera& camera, const Vec3& point_mm);
+
+/// Pixels whose centres lie between r_in and r_out of (cx, cy), set to `c` (r_in < 0: a disc).
+void draw_ring(RgbImage& image, double cx, double cy, double r_in, double r_out, Rgb c);
 
 struct AnnotatedView {
   RgbImage image;
