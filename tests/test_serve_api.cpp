@@ -137,6 +137,29 @@ TEST_F(ServeApi, PageViewsPickAndAWarmReinflation) {
   EXPECT_EQ(client_->Post("/api/pick", R"({"x": 100, "y": 75, "side": "left", "w": 200, "h": 150})",
                           "application/json")->status, 409);
 
+  // Port ranking for the liver on the inflated shape, the scene's port placed: the best few of the
+  // table `pneumo ports` writes, on the anterior skin; then the same scores drawn on the body's view.
+  const auto ranked = client_->Post("/api/ports", R"({"target_label": 5, "ports": [[0, 110, -20]], "top": 3})",
+                                    "application/json");
+  ASSERT_EQ(ranked->status, 200) << ranked->body;
+  const nlohmann::json t = nlohmann::json::parse(ranked->body);
+  EXPECT_EQ(t["target"]["name"], "liver");
+  EXPECT_LE(t["candidates"].size(), 3u);
+  EXPECT_GT(t["candidates_total"].get<int>(), 3);
+  ASSERT_GT(t["feasible_candidates"].get<int>(), 0) << ranked->body;
+  const nlohmann::json& best = t["candidates"][0];
+  EXPECT_TRUE(best["feasible"].get<bool>());
+  EXPECT_GT(best["score"].get<double>(), 0.0);
+  ASSERT_TRUE(best["skin_point_mm"].is_array());
+  EXPECT_GT(best["skin_point_mm"][1].get<double>(), 60.0) << "a port on the anterior skin";
+  EXPECT_TRUE(best["terms"].contains("triangulation")) << "scored against the port already placed";
+  const auto heat = client_->Get("/api/exterior.png?side=anterior&w=200&h=150&ports=0,110,-20&heat=1");
+  ASSERT_EQ(heat->status, 200) << heat->body;
+  EXPECT_NE(heat->body, client_->Get("/api/exterior.png?side=anterior&w=200&h=150&ports=0,110,-20")->body);
+  const auto absent = client_->Post("/api/ports", R"({"target_label": 999})", "application/json");
+  EXPECT_EQ(absent->status, 400);
+  EXPECT_NE(absent->body.find("holds no voxel"), std::string::npos) << absent->body;
+
   const auto again = client_->Post("/api/inflate", R"({"pressure_mmhg": 6})", "application/json");
   ASSERT_EQ(again->status, 202) << again->body;
   const uint64_t g = nlohmann::json::parse(again->body)["generation"];

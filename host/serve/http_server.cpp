@@ -373,7 +373,8 @@ void Server::Impl::routes() {
         ports.push_back(p);
       }
     }
-    res.set_content(on_worker([&] { return session->exterior_png(side, w, h, ports); }), "image/png");
+    const bool heat = q.has_param("heat") && q.get_param_value("heat") == "1";
+    res.set_content(on_worker([&] { return session->exterior_png(side, w, h, ports, heat); }), "image/png");
   });
   http.Post("/api/pick", [this](const httplib::Request& q, httplib::Response& res) {
     const nlohmann::json b = body_json(q);
@@ -382,6 +383,21 @@ void Server::Impl::routes() {
     const int w = whole(b.value("w", 480.0), "w", 16, 1920), h = whole(b.value("h", 360.0), "h", 16, 1080);
     const std::optional<Vec3> p = on_worker([&] { return session->pick(side, w, h, x, y); });
     answer_json(res, {{"skin_point_mm", p ? nlohmann::json{p->x(), p->y(), p->z()} : nlohmann::json()}});
+  });
+  http.Post("/api/ports", [this](const httplib::Request& q, httplib::Response& res) {
+    const nlohmann::json b = body_json(q);
+    if (!b.contains("target_label") || !b["target_label"].is_number())
+      throw InputError("ports: \"target_label\" (an organ's label id) is required");
+    const int target = whole(b["target_label"].get<double>(), "target_label", 1, 65535);
+    const double grid_mm = b.value("grid_mm", 20.0);
+    if (!(grid_mm >= 5.0 && grid_mm <= 100.0)) throw InputError("grid_mm must be 5 to 100");
+    const int top = whole(b.value("top", 10.0), "top", 1, 100);
+    std::vector<Vec3> placed;
+    if (b.contains("ports")) {
+      if (!b["ports"].is_array() || b["ports"].size() > 16) throw InputError("ports: a list of at most 16 points");
+      for (const nlohmann::json& p : b["ports"]) placed.push_back(vec3_of(p, "ports"));
+    }
+    answer_json(res, on_worker([&] { return session->rank_ports(target, placed, grid_mm, top); }));
   });
   http.Get("/api/slices.png", [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(on_worker([&] { return session->slices_png(); }), "image/png");

@@ -9,6 +9,7 @@
 #include "image/png.h"
 #include "mesh/deformation_file.h"
 #include "pipeline/exterior_views.h"
+#include "pipeline/port_planning.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/scene_stages.h"
 #include "pipeline/warp_stage.h"
@@ -204,14 +205,15 @@ void PlanningSession::refresh_shape(const Simulation& sim, const Scene& scene, c
   const WarpResult& w = warps_.warp(scene.device, *warp_mesh, src, WarpBox{{0, 0, 0}, g.dims}, wo);
   auto deformed_ct = std::make_unique<Volume>(g, VoxelType::Float32);
   std::copy(w.ct_hu.begin(), w.ct_hu.end(), deformed_ct->data<float>());
-  Volume labels(g, VoxelType::UInt16);
-  std::copy(w.labels.begin(), w.labels.end(), labels.data<uint16_t>());
-  auto volume = std::make_unique<RenderVolume>(RenderVolume::from(*deformed_ct, &labels));
+  auto labels = std::make_unique<Volume>(g, VoxelType::UInt16);
+  std::copy(w.labels.begin(), w.labels.end(), labels->data<uint16_t>());
+  auto volume = std::make_unique<RenderVolume>(RenderVolume::from(*deformed_ct, labels.get()));
   renderer_.set_volume(*volume);
   const int64_t gas = w.gas_voxels;
   warp_mesh_ = std::move(warp_mesh);
   point_map_ = std::move(point_map);
   deformed_ct_ = std::move(deformed_ct);
+  deformed_labels_ = std::move(labels);
   volume_ = std::move(volume);
   shown_pressure_pa_ = pressure_pa;
   std::lock_guard<std::mutex> lock(status_mutex_);
@@ -258,7 +260,7 @@ std::string PlanningSession::scope_png(const ScopeRequest& q) {
 }
 
 std::string PlanningSession::exterior_png(const std::string& side, int width, int height,
-                                          const std::vector<Vec3>& ports_mm) {
+                                          const std::vector<Vec3>& ports_mm, bool heat) {
   if (!(width >= 16 && width <= 1920 && height >= 16 && height <= 1080))
     throw InputError("the view must be 16 to 1920 × 16 to 1080 pixels");
   const std::string name = "exterior_" + side;
@@ -270,13 +272,47 @@ std::string PlanningSession::exterior_png(const std::string& side, int width, in
     const PointMapFn map = to_deformed();
     std::vector<SkinMark> marks;
     for (std::size_t k = 0; k < ports_mm.size(); ++k) marks.push_back({"port " + std::to_string(k + 1), map(ports_mm[k])});
-    char caption[64];
+    char caption[160];
     std::snprintf(caption, sizeof caption, "%.1f mmHg", shown_pressure_pa_ / units::kPaPerMmHg);
-    const AnnotatedView a = annotated_view(image, c.camera, caption, marks);
     last_exterior_ = Exterior{side, c.camera, image.depth_mm, warp_mesh_, point_map_};
-    return encode_png(a.image);
+    if (heat && last_ranking_) {
+      // The candidates where the shape shown has carried them (the ranking may be of an earlier one).
+      PortRanking shown = last_ranking_->ranking;
+      for (std::size_t k = 0; k < shown.candidates.size(); ++k)
+        if (last_ranking_->on_ct[k]) shown.candidates[k].skin_mm = map(*last_ranking_->on_ct[k]);
+      std::snprintf(caption, sizeof caption, "%.1f mmHg, ports for %s", shown_pressure_pa_ / units::kPaPerMmHg,
+                    last_ranking_->target_name.c_str());
+      return encode_png(port_heat_map(image, c.camera, shown, caption, marks));
+    }
+    return encode_png(annotated_view(image, c.camera, caption, marks).image);
   }
   throw InputError("side must be anterior or left");
+}
+
+nlohmann::json PlanningSession::rank_ports(int target_label, const std::vector<Vec3>& placed_ports_mm, double grid_mm,
+                                          int top) {
+  PortRankOptions o;
+  o.target_label = target_label;
+  o.gas_label = uint16_t(scene_.output.cavity_label);
+  o.grid_mm = grid_mm;
+  const PointMapFn map = to_deformed();
+  for (const Vec3& p : placed_ports_mm) o.other_ports_mm.push_back(map(p));
+  const Geometry& g = deformed_ct_->geometry();
+  Ranking r;
+  r.ranking = pneumo::rank_ports(deformed_labels_->data<uint16_t>(), deformed_ct_->data<float>(), g, o);
+  nlohmann::json table = port_ranking_json(r.ranking, o, scene_label_names(scene_), *point_map_,
+                                           0.5 * g.spacing_mm.minCoeff());
+  for (const nlohmann::json& c : table["candidates"])
+    r.on_ct.push_back(c["skin_point_mm"].is_array() ? std::optional<Vec3>(Vec3(c["skin_point_mm"][0].get<double>(),
+                                                                               c["skin_point_mm"][1].get<double>(),
+                                                                               c["skin_point_mm"][2].get<double>()))
+                                                    : std::nullopt);
+  r.target_name = table["target"]["name"].get<std::string>();
+  last_ranking_ = std::move(r);
+  table["pressure_mmhg"] = shown_pressure_pa_ / units::kPaPerMmHg;
+  table["candidates_total"] = table["candidates"].size();
+  if (int(table["candidates"].size()) > top) table["candidates"].erase(table["candidates"].begin() + top, table["candidates"].end());
+  return table;
 }
 
 std::optional<Vec3> PlanningSession::pick(const std::string& side, int width, int height, double x_px, double y_px) {
@@ -290,16 +326,10 @@ std::optional<Vec3> PlanningSession::pick(const std::string& side, int width, in
   const std::optional<Vec3> ray = c.ray(x_px + 0.5, y_px + 0.5);
   if (!(depth > 0.0f) || !ray) return std::nullopt;
   // The deformed skin point, carried back to the CT as given: a port is planned there and travels.
-  // The first surface's depth is where the skin's opacity begins, within a voxel of the mesh's own
-  // boundary: the first point a little deeper that a tetrahedron carries is the skin point. A ray
-  // that met no surface has no depth (0 or infinite).
+  // A ray that met no surface has no depth (0 or infinite).
   if (!std::isfinite(depth)) return std::nullopt;
-  const double step = 0.5 * volume_->geometry.spacing_mm.minCoeff();
-  for (int k = 0; k <= 8; ++k) {
-    const MappedPoint back = last_exterior_->point_map->to_original(c.position_mm + (double(depth) + k * step) * *ray);
-    if (back.carried) return back.point_mm;
-  }
-  return std::nullopt;
+  return skin_point_on_ct(*last_exterior_->point_map, c.position_mm + double(depth) * *ray, *ray,
+                          0.5 * volume_->geometry.spacing_mm.minCoeff());
 }
 
 std::string PlanningSession::slices_png() {

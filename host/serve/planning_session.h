@@ -17,6 +17,7 @@
 
 #include "core/geometry.h"
 #include "pipeline/simulate.h"
+#include "plan/port_ranking.h"
 #include "render/gl_context.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
@@ -76,13 +77,21 @@ class PlanningSession {
   std::string scope_png(const ScopeRequest& request);
   /// The skin from outside ("anterior" or "left"), after inflation, the given ports marked; the
   /// camera is kept for pick().
-  std::string exterior_png(const std::string& side, int width, int height, const std::vector<Vec3>& ports_mm);
+  /// With `heat`, the last port ranking's candidates drawn on it in the colours of their scores
+  /// (pipeline/port_planning.h), each where the shape shown has carried its skin point.
+  std::string exterior_png(const std::string& side, int width, int height, const std::vector<Vec3>& ports_mm,
+                           bool heat = false);
   /// The skin point under pixel (x, y) of the last exterior view, which must be the one from `side`
   /// at width × height (StaleView otherwise: the user clicked on another), on the CT as given
   /// (carried back through the shape that view showed); nullopt where the ray met no skin.
   std::optional<Vec3> pick(const std::string& side, int width, int height, double x_px, double y_px);
   /// Axial, coronal and sagittal slices before and after, through the middle of the grid.
   std::string slices_png();
+
+  /// Candidate ports for `target_label` ranked on the shape shown (plan/port_ranking.h), the ports
+  /// already placed given on the CT as given: the table `pneumo ports` writes, its first `top`
+  /// candidates (candidates_total says how many there were). Kept for exterior_png's heat map.
+  nlohmann::json rank_ports(int target_label, const std::vector<Vec3>& placed_ports_mm, double grid_mm, int top);
 
   /// The scene as it now stands (the file's text with the changes made), to save as a plan.
   nlohmann::json plan_json(const std::vector<std::pair<std::string, ScopeRequest>>& ports) const;
@@ -111,6 +120,13 @@ class PlanningSession {
   WarpSeries warps_;
   std::unique_ptr<RenderVolume> volume_;
   std::unique_ptr<Volume> deformed_ct_;
+  std::unique_ptr<Volume> deformed_labels_;
+  struct Ranking {   // the last port ranking, its candidates' skin points on the CT as given
+    PortRanking ranking;
+    std::vector<std::optional<Vec3>> on_ct;
+    std::string target_name;
+  };
+  std::optional<Ranking> last_ranking_;
   Renderer renderer_;
   struct Exterior {   // the last exterior view: a pick is made on what the user saw
     std::string side;

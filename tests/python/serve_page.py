@@ -3,7 +3,8 @@
 opens the page (the scene's ports listed), waits for the first equilibrium, clicks the skin on the
 body's view to place a port,
 waits for the laparoscope's view, moves the pressure slider down, waits for the view to change and
-the status to report the new pressure, and saves a screenshot.
+the status to report the new pressure, ranks the ports for the target, places one at the best
+candidate, and saves a screenshot.
 
 Usage: serve_page.py PNEUMO SCENE SCRATCH_DIR [SCREENSHOT]
 Exit 0 when every step held, 1 when one did not (the step is printed), 77 when Chromium or its
@@ -94,9 +95,25 @@ try:
              lambda: status.text.startswith(f"converged at {pressure}.0"), 240)
     wait_for("the laparoscope's view changed with the pressure",
              lambda: driver.execute_script(view_settled, scope, ports_before) and scope.screenshot_as_png != before, 60)
+
+    # Port ranking: the target's candidates scored on the skin, the best listed; a click on the first
+    # places a port there.
+    ports_now = len(driver.find_elements(By.CSS_SELECTOR, "#port-list button"))
+    driver.find_element(By.ID, "rank").click()
+    wait_for("the ranked ports listed", lambda: driver.find_elements(By.CSS_SELECTOR, "#ranked li"), 120)
+    if not driver.find_element(By.ID, "heat").is_selected():
+        fail("the port map shown on the body's view")
+    driver.find_elements(By.CSS_SELECTOR, "#ranked li")[0].click()
+    wait_for("a port placed at the best candidate", lambda: len(driver.find_elements(
+        By.CSS_SELECTOR, "#port-list button")) == ports_now + 1, 60)
+    wait_for("the laparoscope's view from the best candidate",
+             lambda: driver.execute_script(view_settled, scope, ports_now), 60)
+    wait_for("the body's view with the map", lambda: driver.execute_script(
+        "return arguments[0].complete && arguments[0].naturalWidth > 0 && arguments[0].src.includes('heat=1')",
+        exterior), 60)
     if screenshot:
         driver.save_screenshot(screenshot)
-    print(f"ok: port placed, view changed, status '{status.text}'")
+    print(f"ok: port placed, view changed, ports ranked and one placed, status '{status.text}'")
 finally:
     if driver:
         driver.quit()

@@ -67,7 +67,9 @@ function refreshScope() {
 
 function refreshExterior() {
   const ports = state.ports.map((p) => p.skin_point_mm.map((v) => v.toFixed(1)).join(",")).join(";");
-  $("exterior").src = "/api/exterior.png?" + new URLSearchParams({ side: $("side").value, w: 480, h: 360, ports, n: Date.now() });
+  const q = { side: $("side").value, w: 480, h: 360, ports, n: Date.now() };
+  if ($("heat").checked) q.heat = 1;
+  $("exterior").src = "/api/exterior.png?" + new URLSearchParams(q);
 }
 
 function refreshSlices() { $("slices").src = "/api/slices.png?n=" + Date.now(); }
@@ -173,6 +175,37 @@ $("target").addEventListener("change", () => {
   refreshScope();
 });
 $("side").addEventListener("change", refreshExterior);
+$("heat").addEventListener("change", refreshExterior);
+// Port ranking (docs/ports.md): the target's candidates on the skin, scored; the best listed, each
+// placed as a port by a click.
+$("rank").addEventListener("click", async () => {
+  const target = +$("target").value;
+  if (!target) { setStatus("choose an organ as the target first", true); return; }
+  $("rank").disabled = true;
+  try {
+    const t = await post("/api/ports", { target_label: target, ports: state.ports.map((p) => p.skin_point_mm), top: 5 });
+    const list = $("ranked");
+    list.textContent = "";
+    for (const c of t.candidates.filter((c) => c.feasible && c.skin_point_mm)) {
+      const li = document.createElement("li");
+      li.textContent = `score ${c.score.toFixed(2)}: sees ${(100 * c.visible_fraction).toFixed(0)} %, ` +
+                       `${c.skin_to_target_mm.toFixed(0)} mm to the target`;
+      li.onclick = () => {
+        const p = newPort("port " + (state.ports.length + 1), c.skin_point_mm);
+        p.target_label = target;
+        state.ports.push(p);
+        selectPort(state.ports.length - 1);
+        refreshExterior();
+      };
+      list.appendChild(li);
+    }
+    if (!list.children.length) setStatus(`no port reaches ${t.target.name}: every path meets an organ or no gas`, true);
+    $("heat").disabled = false;
+    $("heat").checked = true;
+    refreshExterior();
+  } catch (e) { setStatus(e.message, true); }
+  $("rank").disabled = false;
+});
 $("plan").addEventListener("click", async () => {
   if (!state.ports.length) { setStatus("place a port on the skin first", true); return; }
   const ports = state.ports.map((p) => {
