@@ -1,6 +1,7 @@
 #include "serve/planning_session.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
@@ -193,6 +194,7 @@ void PlanningSession::refresh_shape(const Simulation& sim, const Scene& scene, c
                                     double pressure_pa) {
   // Everything is built aside and committed at the end, so a failure (memory, the device) leaves
   // the shape shown before intact, its point map and volume agreeing.
+  const auto t0 = Clock::now();
   auto warp_mesh = std::make_shared<const WarpMesh>(make_warp_mesh(sim.mesh, displacements(sim.mesh, x)));
   auto point_map = std::make_shared<const PointMap>(*warp_mesh, sim.roles.role.data());
   WarpSource src;
@@ -202,18 +204,27 @@ void PlanningSession::refresh_shape(const Simulation& sim, const Scene& scene, c
   WarpOptions wo;
   wo.cavity_label = uint16_t(scene.output.cavity_label);
   const Geometry& g = sim.roles.geometry;
+  const double s_map = seconds_since(t0);
   const WarpResult& w = warps_.warp(scene.device, *warp_mesh, src, WarpBox{{0, 0, 0}, g.dims}, wo);
-  auto deformed_ct = std::make_unique<Volume>(g, VoxelType::Float32);
-  std::copy(w.ct_hu.begin(), w.ct_hu.end(), deformed_ct->data<float>());
-  auto labels = std::make_unique<Volume>(g, VoxelType::UInt16);
-  std::copy(w.labels.begin(), w.labels.end(), labels->data<uint16_t>());
-  auto volume = std::make_unique<RenderVolume>(RenderVolume::from(*deformed_ct, labels.get()));
+  const double s_warp = seconds_since(t0) - s_map;
+  // The views' volume straight from the warp, HU rounded to whole numbers: as `pneumo run` stores
+  // an int16 CT's deformed_ct.nii.gz (warp_stage.h), so the renderer packs HU and gradient into one
+  // 16-bit texture as it does there, and nothing else holds a copy (the slices and the port ranking
+  // read this one). Half a HU is below any transfer function's resolution.
+  auto volume = std::make_unique<RenderVolume>();
+  volume->geometry = g;
+  volume->hu.resize(w.ct_hu.size());
+  for (std::size_t n = 0; n < w.ct_hu.size(); ++n) volume->hu[n] = std::nearbyint(std::clamp(w.ct_hu[n], -32767.0f, 32767.0f));
+  volume->hu_is_int16 = true;
+  volume->labels = w.labels;
+  const double s_volume = seconds_since(t0) - s_map - s_warp;
   renderer_.set_volume(*volume);
+  log::debug("serve: shape refreshed: point map " + std::to_string(s_map) + " s, warp " + std::to_string(s_warp) +
+             " s, volumes " + std::to_string(s_volume) + " s, upload " +
+             std::to_string(seconds_since(t0) - s_map - s_warp - s_volume) + " s");
   const int64_t gas = w.gas_voxels;
   warp_mesh_ = std::move(warp_mesh);
   point_map_ = std::move(point_map);
-  deformed_ct_ = std::move(deformed_ct);
-  deformed_labels_ = std::move(labels);
   volume_ = std::move(volume);
   shown_pressure_pa_ = pressure_pa;
   std::lock_guard<std::mutex> lock(status_mutex_);
@@ -297,9 +308,9 @@ nlohmann::json PlanningSession::rank_ports(int target_label, const std::vector<V
   o.grid_mm = grid_mm;
   const PointMapFn map = to_deformed();
   for (const Vec3& p : placed_ports_mm) o.other_ports_mm.push_back(map(p));
-  const Geometry& g = deformed_ct_->geometry();
+  const Geometry& g = volume_->geometry;
   Ranking r;
-  r.ranking = pneumo::rank_ports(deformed_labels_->data<uint16_t>(), deformed_ct_->data<float>(), g, o);
+  r.ranking = pneumo::rank_ports(volume_->labels.data(), volume_->hu.data(), g, o);
   nlohmann::json table = port_ranking_json(r.ranking, o, scene_label_names(scene_), *point_map_,
                                            0.5 * g.spacing_mm.minCoeff());
   for (const nlohmann::json& c : table["candidates"])
@@ -339,7 +350,9 @@ std::string PlanningSession::slices_png() {
   char title[96];
   std::snprintf(title, sizeof title, "after, %.1f mmHg", shown_pressure_pa_ / units::kPaPerMmHg);
   view.title = title;
-  return encode_png(stack_rows({before, render_slice_row(*deformed_ct_, nullptr, view)}));
+  Volume after(volume_->geometry, VoxelType::Float32);
+  std::copy(volume_->hu.begin(), volume_->hu.end(), after.data<float>());
+  return encode_png(stack_rows({before, render_slice_row(after, nullptr, view)}));
 }
 
 nlohmann::json PlanningSession::plan_json(const std::vector<std::pair<std::string, ScopeRequest>>& ports) const {

@@ -118,9 +118,7 @@ class PlanningSession {
   std::shared_ptr<const WarpMesh> warp_mesh_;
   std::shared_ptr<const PointMap> point_map_;   // refers to *warp_mesh_ and sim_.roles
   WarpSeries warps_;
-  std::unique_ptr<RenderVolume> volume_;
-  std::unique_ptr<Volume> deformed_ct_;
-  std::unique_ptr<Volume> deformed_labels_;
+  std::unique_ptr<RenderVolume> volume_;   // the shape shown: the deformed CT (whole HU) and labels
   struct Ranking {   // the last port ranking, its candidates' skin points on the CT as given
     PortRanking ranking;
     std::vector<std::optional<Vec3>> on_ct;
