@@ -345,6 +345,9 @@ void Server::Impl::routes() {
     j["generation_latest"] = worker->generation();
     answer_json(res, j);
   });
+  http.Get("/api/case", [this](const httplib::Request&, httplib::Response& res) {
+    answer_json(res, session->case_info());
+  });
   http.Post("/api/inflate", [this](const httplib::Request& q, httplib::Response& res) {
     const nlohmann::json b = body_json(q);
     InflateRequest r;

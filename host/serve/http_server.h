@@ -2,8 +2,10 @@
 // `pneumo serve SCENE`: one case resident (planning_session.h) behind a local web page and its HTTP
 // API (cpp-httplib). The API, all JSON or PNG:
 //   GET  /                      the page (index.html, app.js, style.css, embedded)
+//   GET  /api/case              what does not change: the scene's ports and the label map's ids with
+//                               their names (read once)
 //   GET  /api/status            settings, solve progress, the last equilibrium's figures, the plan's
-//                               state, the scene's ports and the label map's ids with their names
+//                               state
 //   POST /api/inflate           {"pressure_mmhg", "wall_young_kpa", "preset"}: a re-inflation from the
 //                               last equilibrium; latest wins (202 with its generation)
 //   GET  /api/scope.png         the laparoscope at a port: sx,sy,sz (skin point, CT as given, mm),

@@ -39,6 +39,7 @@ PlanningSession::PlanningSession(nlohmann::json scene_json, std::string scene_pa
       renderer_(false, backend) {
   sim_ = prepare_simulation(scene_);
   x_ = sim_.mesh.rest_m;
+  case_ = {{"ports", scene_ports()}, {"labels", label_list()}};
   {
     std::lock_guard<std::mutex> lock(status_mutex_);
     status_ = nlohmann::json{{"pressure_mmhg", 0.0},
@@ -50,9 +51,7 @@ PlanningSession::PlanningSession(nlohmann::json scene_json, std::string scene_pa
              {"step", 0},
              {"shape", 0},
              {"tetrahedra", int64_t(sim_.mesh.tets.size())},
-             {"renderer", renderer_.describe()},
-             {"ports", scene_ports()},
-             {"labels", label_list()}};
+             {"renderer", renderer_.describe()}};
   }
   refresh_shape(sim_, scene_, x_, 0.0);
 }

@@ -98,6 +98,9 @@ class PlanningSession {
 
   /// Thread-safe: the settings, the solve's progress and the last equilibrium's figures.
   nlohmann::json status() const;
+  /// Any thread: what does not change while serving, read once by the page: the scene's ports (to
+  /// start from) and the label map's ids with their names (the targets).
+  const nlohmann::json& case_info() const { return case_; }
   void set_error(const std::string& message);
 
  private:
@@ -110,6 +113,7 @@ class PlanningSession {
 
   nlohmann::json scene_json_;
   std::string scene_path_;
+  nlohmann::json case_;             // set in the constructor, never changed (case_info)
   Scene scene_;
   Simulation sim_;
   std::vector<Vec3> x_;             // the current shape (m), sim_.mesh.rest_m before the first solve

@@ -119,11 +119,14 @@ async function poll() {
       $("plan-status").appendChild(a);
     }
     if (state.first === undefined) {   // the scene's settings, labels and ports to start from
+      const r = await fetch("/api/case");
+      if (!r.ok) throw new Error(r.statusText);
+      const c = await r.json();
       state.first = true;
       $("pressure").value = s.target_pressure_mmhg; $("wall").value = s.wall_young_kpa;
       if (s.preset !== "none") $("preset").value = s.preset;
-      fillTargets(s.labels, s.ports);
-      state.ports = s.ports.map((p) => Object.assign({ target_label: null }, p));
+      fillTargets(c.labels, c.ports);
+      state.ports = c.ports.map((p) => Object.assign({ target_label: null }, p));
       showOutputs(); showPorts();
       if (state.ports.length) selectPort(0);
     }
