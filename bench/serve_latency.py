@@ -6,8 +6,9 @@ over HTTP, as the page asks:
   - load: process start to the first answer, and to the first equilibrium;
   - camera: a new laparoscope view (the aim turned by a few degrees), N times;
   - exterior: a new body view, N times;
-  - pressure: a change of 2 mmHg, from the request to the first view of a new shape and to the
-    converged equilibrium (alternating up and down, N times).
+  - pressure: a change of 2 mmHg, from the request to the first view of a new shape (at the half
+    size the page asks for while the solver runs) and to the converged equilibrium (alternating up
+    and down, N times).
 Records the load average and the CPU other processes used meanwhile (from /proc/stat less this
 run's own), since this machine is shared. Writes a Markdown table (stdout, or --markdown FILE) and
 JSON (--json FILE).
@@ -109,11 +110,12 @@ try:
         t = time.time()
         g = post("/api/inflate", {"pressure_mmhg": p})["generation"]
         wait(lambda s: s["shape"] > shape)
-        get(f"/api/scope.png?sx={sx}&sy={sy}&sz={sz}&label={target}&ins=45&obl=30&w=480&h=360")
+        # While the solver runs the page asks for the view at half size (host/serve/page/app.js).
+        get(f"/api/scope.png?sx={sx}&sy={sy}&sz={sz}&label={target}&ins=45&obl=30&w=240&h=180")
         first.append(time.time() - t)
         wait(lambda s: not s["solving"] and s.get("generation") == g)
         conv.append(time.time() - t)
-    rows["pressure ±2 mmHg to the first updated view, s"] = first
+    rows["pressure ±2 mmHg to the first updated view (240×180, as the page asks while solving), s"] = first
     rows["pressure ±2 mmHg to the equilibrium, s"] = conv
     s = status()
 finally:
