@@ -93,3 +93,38 @@ TEST(SerialWorker, AFullQueueIsRefusedAndAStoppedWorkerTakesNothing) {
   EXPECT_THROW(w.run([] { return 0; }), SerialWorker::Stopping);
   EXPECT_THROW(w.start([](SerialWorker&, uint64_t) {}), SerialWorker::Stopping);
 }
+
+// After a new shape, a long task waits briefly for the views a watching page asks: a view requested
+// within the window is answered before the task goes on (here, before a step of 400 ms it would
+// otherwise queue behind); with nobody watching (no short task for kWatchedSeconds) it does not wait.
+TEST(SerialWorker, ANewShapeWaitsForTheViewsOfAWatchingPageOnly) {
+  using namespace std::chrono;
+  {
+    SerialWorker unwatched;
+    std::atomic<int64_t> waited_ms{-1};
+    std::atomic<bool> done{false};
+    unwatched.start([&](SerialWorker& worker, uint64_t g) {
+      const auto t = steady_clock::now();
+      worker.checkpoint_for_views(g, milliseconds(300));
+      waited_ms = duration_cast<milliseconds>(steady_clock::now() - t).count();
+      done = true;
+    });
+    wait_until(done);
+    EXPECT_LT(waited_ms.load(), 150) << "an unwatched solve does not wait";
+  }
+  SerialWorker w;
+  w.run([] { return 0; }).get();   // the page's earlier view: it is watching
+  std::atomic<bool> at_news{false}, step_done{false};
+  w.start([&](SerialWorker& worker, uint64_t g) {
+    at_news = true;
+    worker.checkpoint_for_views(g, milliseconds(2000));
+    std::this_thread::sleep_for(milliseconds(400));   // the solver's next step
+    step_done = true;
+  });
+  wait_until(at_news);
+  ASSERT_TRUE(at_news);
+  std::this_thread::sleep_for(milliseconds(50));   // the page's poll sees the shape, then asks
+  const bool before_the_step = w.run([&] { return !step_done.load(); }).get();
+  EXPECT_TRUE(before_the_step) << "the view of the new shape waited for the solver's next step";
+  w.stop();
+}

@@ -169,6 +169,9 @@ void PlanningSession::inflate(const InflateRequest& request, SerialWorker& worke
       refresh_cost_s = seconds_since(r0);
       log::debug("serve: shape of step " + std::to_string(s.step) + " shown " + std::to_string(seconds_since(t0)) +
                  " s after the request (warp and upload " + std::to_string(refresh_cost_s) + " s)");
+      // The views of the new shape before the next step (a Newton step takes about as long as a view).
+      worker.checkpoint_for_views(generation, kViewWait);
+      return;
     }
     worker.checkpoint(generation);
   };

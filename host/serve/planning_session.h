@@ -57,6 +57,9 @@ class PlanningSession {
   /// The views follow the solve at most this often, and spend at most a third of the time on it
   /// (a refresh warps the CT and uploads the volume: about a second on the medium phantom here).
   static constexpr double kShapeRefreshSeconds = 0.7;
+  /// After a new shape, how long the solve waits for the views a watching page asks for it: the
+  /// page polls every 0.1 s while a solve runs (page/app.js), so its request comes within this.
+  static constexpr std::chrono::milliseconds kViewWait{250};
 
   /// `scene_json` is the scene file as written (presets apply to it when changed), `scene_path` its
   /// path (relative paths resolve from its folder).

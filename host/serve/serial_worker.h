@@ -9,8 +9,10 @@
 //    running, which stops at its next checkpoint, and replaces any still waiting.
 // A long task calls checkpoint() at each solver snapshot: the short tasks waiting are answered
 // there, so the views keep coming while a solve runs, and a superseded task stops by throwing
-// Superseded, which the worker swallows.
+// Superseded, which the worker swallows. After a new shape it calls checkpoint_for_views(), which
+// also waits briefly for the views a watching page asks for it.
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -70,6 +72,7 @@ class SerialWorker {
       if (stop_) throw Stopping();
       if (short_.size() >= kMaxShortTasks) throw Busy();
       short_.emplace_back([task] { (*task)(); });
+      last_short_ = std::chrono::steady_clock::now();
     }
     cv_.notify_one();
     return result;
@@ -98,6 +101,24 @@ class SerialWorker {
   void checkpoint(uint64_t generation) {
     service();
     if (superseded(generation)) throw Superseded();
+  }
+
+  /// A short task arriving within this long of the last one means a page is watching.
+  static constexpr std::chrono::seconds kWatchedSeconds{5};
+
+  /// In a long task that just changed what the views show (a new shape): checkpoint(), then, when a
+  /// page is watching (a short task came within kWatchedSeconds), waits up to `window` for the views
+  /// that change prompts and answers them before the task goes on. A page sees the change at its
+  /// next poll and asks at once; without the wait its view would queue behind the solver's next step.
+  /// An unwatched task never waits.
+  void checkpoint_for_views(uint64_t generation, std::chrono::milliseconds window) {
+    checkpoint(generation);
+    {
+      std::unique_lock<std::mutex> lock(m_);
+      if (std::chrono::steady_clock::now() - last_short_ > kWatchedSeconds) return;
+      cv_.wait_for(lock, window, [&] { return stop_ || !short_.empty() || long_.has_value(); });
+    }
+    checkpoint(generation);
   }
 
   /// Stops after the task running: a long one is superseded; short ones waiting are still run.
@@ -149,6 +170,7 @@ class SerialWorker {
   std::mutex m_;
   std::condition_variable cv_;
   std::deque<std::function<void()>> short_;
+  std::chrono::steady_clock::time_point last_short_{};   // when the last short task came (guarded by m_)
   std::optional<std::pair<uint64_t, LongTask>> long_;
   std::atomic<uint64_t> generation_{0};
   std::atomic<bool> stopping_{false};
