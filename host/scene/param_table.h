@@ -327,6 +327,11 @@ std::vector<Param<O>> inline_params(S O::*field, const Table<S>& table) {
 
 /// The table of the whole scene (scene_params.cpp).
 const Table<Scene>& scene_table();
+/// The table of one item of render.ports (scene_params.cpp): pneumo serve reads and writes ports with it.
+const Table<Port>& scene_port_table();
+/// A port's cross-key rules (scene_validate.cpp): one target, a lens its field of view allows, a
+/// direction from the skin point to a target point.
+void check_port(const Port& p, const At& at);
 /// Cross-key rules the table cannot express (scene_validate.cpp): a label in two role lists,
 /// ROI corners, port targets, unique view names, camera geometry.
 void validate_scene(const Scene& s, const ReadContext& ctx);

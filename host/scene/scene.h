@@ -191,6 +191,13 @@ Scene parse_scene(const nlohmann::json& j, const std::string& origin_path);
 /// Every key at its default.
 Scene default_scene();
 
+/// One item of render.ports as the scene file writes it: every key, as Scene::echo() writes it.
+nlohmann::json port_json(const Port& p);
+/// One item of render.ports read with every check a scene's port gets (its keys and their ranges,
+/// one target, a lens its field of view allows); InputError "<what>: <key> = <value> <problem>"
+/// otherwise. What `pneumo serve` reads the page's ports with.
+Port read_port(const nlohmann::json& j, const std::string& what);
+
 /// docs/scene_reference.md: one Markdown table per section, generated from the parameter table.
 std::string scene_reference_markdown();
 

@@ -449,6 +449,8 @@ const Table<Landmark>& landmark_table() {
 
 }  // namespace
 
+const Table<Port>& scene_port_table() { return port_table(); }
+
 const Table<Scene>& scene_table() {
   static const Table<Scene> t{
       {"$schema_version", &Scene::schema_version, "", in(1, 1), "Version of this format; optional."},

@@ -149,14 +149,9 @@ void check_views(const ViewSettings& r, const At& render) {
     check_pose(c.position_mm, c.look_at_mm, c.optics, at, "position_mm", "look_at_mm", at);
   }
   for (std::size_t i = 0; i < r.ports.size(); ++i) {
-    const Port& p = r.ports[i];
     const At at = render.child("ports").item(i);
-    claim(p.name, at);
-    check_lens(p.optics, at);
-    if (p.target_mm.has_value() == p.target_label.has_value())
-      at.fail(p.target_mm ? "gives both target_mm and target_label; give one"
-                          : "gives neither target_mm nor target_label; give one");
-    if (p.target_mm) check_pose(p.skin_point_mm, *p.target_mm, p.optics, at, "skin_point_mm", "target_mm", at);
+    claim(r.ports[i].name, at);
+    check_port(r.ports[i], at);
   }
   for (std::size_t i = 0; i < r.paths.size(); ++i) {
     const CameraPath& p = r.paths[i];
@@ -192,6 +187,14 @@ void check_landmarks(const std::vector<Landmark>& marks, const At& list) {
 }
 
 }  // namespace
+
+void check_port(const Port& p, const At& at) {
+  check_lens(p.optics, at);
+  if (p.target_mm.has_value() == p.target_label.has_value())
+    at.fail(p.target_mm ? "gives both target_mm and target_label; give one"
+                        : "gives neither target_mm nor target_label; give one");
+  if (p.target_mm) check_pose(p.skin_point_mm, *p.target_mm, p.optics, at, "skin_point_mm", "target_mm", at);
+}
 
 void validate_scene(const Scene& s, const ReadContext& ctx) {
   const At root{&ctx, ""};
