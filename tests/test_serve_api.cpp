@@ -85,6 +85,22 @@ int png_width(const std::string& bytes) {
   return w;
 }
 
+/// Mean absolute difference of two PNGs' RGB values (0–255), 255 when they differ in size.
+double mean_abs_difference(const std::string& a, const std::string& b) {
+  int wa = 0, ha = 0, wb = 0, hb = 0, c = 0;
+  unsigned char* pa = stbi_load_from_memory(reinterpret_cast<const unsigned char*>(a.data()), int(a.size()), &wa, &ha, &c, 3);
+  unsigned char* pb = stbi_load_from_memory(reinterpret_cast<const unsigned char*>(b.data()), int(b.size()), &wb, &hb, &c, 3);
+  double d = 255.0;
+  if (pa && pb && wa == wb && ha == hb) {
+    double sum = 0.0;
+    for (int k = 0; k < wa * ha * 3; ++k) sum += std::abs(int(pa[k]) - int(pb[k]));
+    d = sum / (wa * ha * 3.0);
+  }
+  if (pa) stbi_image_free(pa);
+  if (pb) stbi_image_free(pb);
+  return d;
+}
+
 }  // namespace
 
 // Compared: what the page and its views must be (the page's own files, PNGs of the asked size), the
@@ -174,6 +190,36 @@ TEST_F(ServeApi, PageViewsPickAndAWarmReinflation) {
   EXPECT_LT(s["cavity_volume_ml"].get<double>(), cavity12);
   const auto scope6 = client_->Get(scope_query().c_str());
   EXPECT_NE(scope6->body, scope->body) << "the view follows the new shape";
+
+  // A plan: each port read as a scene's; one aimed by dragging (yaw 20°) keeps that aim as a target
+  // point on the dragged axis, the other its organ. A port the scene would refuse is refused first.
+  const auto bad = client_->Post(
+      "/api/plan", R"({"ports": [{"skin_point_mm": [0, 110, -20], "target_label": 5, "fov_deg": 200}]})",
+      "application/json");
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_NE(bad->body.find("plan: port 1: port.fov_deg = 200"), std::string::npos) << bad->body;
+  const auto plan = client_->Post("/api/plan", R"({"ports": [
+      {"skin_point_mm": [0, 110, -20], "target_label": 5, "insertion_mm": 45, "yaw_deg": 20},
+      {"skin_point_mm": [0, 110, -20], "target_label": 5, "insertion_mm": 45}]})", "application/json");
+  ASSERT_EQ(plan->status, 202) << plan->body;
+  const nlohmann::json written = nlohmann::json::parse(testing_support::slurp(dir_.file("serve_out/plan.json")));
+  const nlohmann::json& ports = written["render"]["ports"];
+  ASSERT_EQ(ports.size(), 2u);
+  EXPECT_TRUE(ports[0]["target_label"].is_null()) << ports[0].dump();
+  ASSERT_TRUE(ports[0]["target_mm"].is_array()) << ports[0].dump();
+  EXPECT_EQ(ports[1]["target_label"], 5);
+  EXPECT_EQ(ports[1]["insertion_mm"], 45.0);
+  // The saved point is on the dragged axis: the plan's port, aimed at it without a drag, sees what
+  // the dragged view saw (the point goes back to the CT as given and forwards again).
+  const nlohmann::json& aimed = ports[0]["target_mm"];
+  const std::string dragged = client_->Get("/api/scope.png?sx=0&sy=110&sz=-20&label=5&ins=45&yaw=20&w=160&h=120")->body;
+  const std::string saved = client_->Get(("/api/scope.png?sx=0&sy=110&sz=-20&ins=45&w=160&h=120&tx=" +
+                                          std::to_string(aimed[0].get<double>()) + "&ty=" + std::to_string(aimed[1].get<double>()) +
+                                          "&tz=" + std::to_string(aimed[2].get<double>())).c_str())->body;
+  const std::string undragged = client_->Get("/api/scope.png?sx=0&sy=110&sz=-20&label=5&ins=45&w=160&h=120")->body;
+  EXPECT_LT(mean_abs_difference(dragged, saved), 2.0);
+  EXPECT_GT(mean_abs_difference(dragged, undragged), 5.0) << "a 20° turn shows another part of the cavity";
+  EXPECT_EQ(written["load"]["pressure_mmhg"], 6.0);
 }
 
 // Latest wins: two requests in a row, the first superseded before it ends; the status ends at the

@@ -76,17 +76,26 @@ Vec3 vec3_of(const nlohmann::json& j, const std::string& what) {
   return v;
 }
 
+/// The laparoscope a view asks for: the port from the query, read as a scene's port (its checks,
+/// its messages), the dragged aim and the image size.
 ScopeRequest scope_request(const httplib::Request& q) {
+  nlohmann::json port = {{"name", "view"}};
+  port["skin_point_mm"] = {number(q, "sx", NAN), number(q, "sy", NAN), number(q, "sz", NAN)};
+  if (!(std::isfinite(port["skin_point_mm"][0].get<double>()) && std::isfinite(port["skin_point_mm"][1].get<double>()) &&
+        std::isfinite(port["skin_point_mm"][2].get<double>())))
+    throw InputError("sx, sy, sz (the port's skin point, mm) are required");
+  if (q.has_param("label")) {
+    port["target_label"] = whole(number(q, "label", 0), "label", 1, 65535);
+  } else {
+    const Vec3 t(number(q, "tx", NAN), number(q, "ty", NAN), number(q, "tz", NAN));
+    if (!t.allFinite()) throw InputError("label or tx, ty, tz (the target) are required");
+    port["target_mm"] = {t.x(), t.y(), t.z()};
+  }
+  for (const auto& [param, key] : {std::pair{"ins", "insertion_mm"}, {"fov", "fov_deg"}, {"obl", "oblique_deg"},
+                                   {"roll", "roll_deg"}})
+    if (q.has_param(param)) port[key] = number(q, param, 0.0);
   ScopeRequest s;
-  s.skin_point_mm = Vec3(number(q, "sx", NAN), number(q, "sy", NAN), number(q, "sz", NAN));
-  if (!s.skin_point_mm.allFinite()) throw InputError("sx, sy, sz (the port's skin point, mm) are required");
-  if (q.has_param("label")) s.target_label = whole(number(q, "label", 0), "label", 1, 65535);
-  else s.target_mm = Vec3(number(q, "tx", NAN), number(q, "ty", NAN), number(q, "tz", NAN));
-  if (s.target_mm && !s.target_mm->allFinite()) throw InputError("label or tx, ty, tz (the target) are required");
-  s.insertion_mm = number(q, "ins", s.insertion_mm);
-  s.fov_deg = number(q, "fov", s.fov_deg);
-  s.oblique_deg = number(q, "obl", s.oblique_deg);
-  s.roll_deg = number(q, "roll", s.roll_deg);
+  s.port = read_port(port, "the view's port");
   s.yaw_deg = number(q, "yaw", 0.0);
   s.pitch_deg = number(q, "pitch", 0.0);
   s.width = whole(number(q, "w", s.width), "w", 16, 1920);
@@ -217,18 +226,20 @@ void Server::stop() { impl_->http.stop(); }
 void Server::Impl::start_plan(const nlohmann::json& body) {
   if (!body.contains("ports") || !body["ports"].is_array() || body["ports"].size() > 16)
     throw InputError("plan: \"ports\" must be a list of at most 16 ports");
-  std::vector<std::pair<std::string, ScopeRequest>> ports;
-  for (const nlohmann::json& p : body["ports"]) {
-    if (!p.is_object()) throw InputError("plan: each port is an object");
+  std::vector<ScopeRequest> ports;
+  for (const nlohmann::json& item : body["ports"]) {
+    if (!item.is_object()) throw InputError("plan: each port is an object");
+    // The page's port: a scene's port (read with a scene port's checks) and the aim it dragged.
+    nlohmann::json p = item;
     ScopeRequest q;
-    q.skin_point_mm = vec3_of(p.value("skin_point_mm", nlohmann::json()), "skin_point_mm");
-    if (p.contains("target_label") && p["target_label"].is_number_integer()) q.target_label = p["target_label"].get<int>();
-    else q.target_mm = vec3_of(p.value("target_mm", nlohmann::json()), "target_mm");
-    q.insertion_mm = p.value("insertion_mm", q.insertion_mm);
-    q.fov_deg = p.value("fov_deg", q.fov_deg);
-    q.oblique_deg = p.value("oblique_deg", q.oblique_deg);
-    q.roll_deg = p.value("roll_deg", q.roll_deg);
-    ports.emplace_back("port_" + std::to_string(ports.size() + 1), q);
+    for (const auto& [key, field] : {std::pair{"yaw_deg", &q.yaw_deg}, {"pitch_deg", &q.pitch_deg}}) {
+      if (p.contains(key) && !p[key].is_number()) throw InputError(std::string("plan: ") + key + " must be a number");
+      *field = p.value(key, 0.0);
+      p.erase(key);
+    }
+    p["name"] = "port_" + std::to_string(ports.size() + 1);   // a file name (the page's names hold spaces)
+    q.port = read_port(p, "plan: port " + std::to_string(ports.size() + 1));
+    ports.push_back(q);
   }
   nlohmann::json plan = on_worker([&] { return session->plan_json(ports); });
   // The inputs by absolute path: the plan lives in another folder than the scene.

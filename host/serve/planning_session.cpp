@@ -67,17 +67,7 @@ InflateRequest PlanningSession::merged(const InflateRequest& r) const {
 
 nlohmann::json PlanningSession::scene_ports() const {
   nlohmann::json list = nlohmann::json::array();
-  for (const Port& p : scene_.render.ports) {
-    nlohmann::json j = {{"name", p.name},
-                        {"skin_point_mm", {p.skin_point_mm.x(), p.skin_point_mm.y(), p.skin_point_mm.z()}},
-                        {"insertion_mm", p.insertion_mm},
-                        {"fov_deg", p.optics.fov_deg},
-                        {"oblique_deg", p.optics.oblique_deg},
-                        {"roll_deg", p.optics.roll_deg}};
-    if (p.target_label) j["target_label"] = *p.target_label;
-    if (p.target_mm) j["target_mm"] = {p.target_mm->x(), p.target_mm->y(), p.target_mm->z()};
-    list.push_back(j);
-  }
+  for (const Port& p : scene_.render.ports) list.push_back(port_json(p));
   return list;
 }
 
@@ -236,36 +226,27 @@ void PlanningSession::refresh_shape(const Simulation& sim, const Scene& scene, c
 
 PointMapFn PlanningSession::to_deformed() const { return deformed_point_fn(*point_map_, false); }
 
+PlanningSession::Aim PlanningSession::aim(const ScopeRequest& q) const {
+  if (!(std::abs(q.yaw_deg) <= 180 && std::abs(q.pitch_deg) <= 89)) throw InputError("yaw_deg ±180, pitch_deg ±89");
+  const PointMapFn map = to_deformed();
+  const Vec3 target = q.port.target_label ? label_centroid_mm(*volume_, *q.port.target_label) : map(*q.port.target_mm);
+  Aim a;
+  a.skin = map(q.port.skin_point_mm);
+  a.axis = target - a.skin;
+  if (a.axis.norm() < 1e-6) throw InputError("the target lies on the port's skin point");
+  const Vec3 up(0, 0, 1);
+  a.axis = Eigen::AngleAxisd(q.yaw_deg * M_PI / 180.0, up) * a.axis;
+  const Vec3 right = a.axis.cross(up);
+  if (right.norm() > 1e-9) a.axis = Eigen::AngleAxisd(q.pitch_deg * M_PI / 180.0, right.normalized()) * a.axis;
+  return a;
+}
+
 std::string PlanningSession::scope_png(const ScopeRequest& q) {
   if (!(q.width >= 16 && q.width <= 1920 && q.height >= 16 && q.height <= 1080))
     throw InputError("the view must be 16 to 1920 × 16 to 1080 pixels");
-  // The scene's own limits for a port (docs/scene_reference.md).
-  if (!(q.fov_deg > 0 && q.fov_deg < 180)) throw InputError("fov_deg must be above 0 and below 180");
-  if (!(q.oblique_deg >= 0 && q.oblique_deg <= 90)) throw InputError("oblique_deg must be 0 to 90");
-  if (!(q.roll_deg >= -180 && q.roll_deg <= 180)) throw InputError("roll_deg must be -180 to 180");
-  if (!(q.insertion_mm >= 0 && q.insertion_mm <= 500)) throw InputError("insertion_mm must be 0 to 500");
-  if (!(std::abs(q.yaw_deg) <= 180 && std::abs(q.pitch_deg) <= 89)) throw InputError("yaw_deg ±180, pitch_deg ±89");
-  const PointMapFn map = to_deformed();
-  Vec3 target;
-  if (q.target_label) target = label_centroid_mm(*volume_, *q.target_label);
-  else if (q.target_mm) target = map(*q.target_mm);
-  else throw InputError("a port needs a target: an organ label or a point");
-  const Vec3 skin = map(q.skin_point_mm);
-  // Aiming: the axis from the skin point to the target, turned by yaw about the superior axis and
-  // by pitch about the axis's own right.
-  Vec3 axis = target - skin;
-  if (axis.norm() < 1e-6) throw InputError("the target lies on the port's skin point");
-  const Vec3 up(0, 0, 1);
-  axis = Eigen::AngleAxisd(q.yaw_deg * M_PI / 180.0, up) * axis;
-  Vec3 right = axis.cross(up);
-  if (right.norm() > 1e-9)
-    axis = Eigen::AngleAxisd(q.pitch_deg * M_PI / 180.0, right.normalized()) * axis;
-  const ScopePose pose = port_pose(q.skin_point_mm, skin + axis, q.insertion_mm, map, up);
-  Optics optics;
-  optics.fov_deg = q.fov_deg;
-  optics.oblique_deg = q.oblique_deg;
-  optics.roll_deg = q.roll_deg;
-  const ViewCamera camera = make_view_camera(pose, optics, q.width, q.height);
+  const Aim a = aim(q);   // the port itself was checked as a scene's (read_port)
+  const ScopePose pose = port_pose(q.port.skin_point_mm, a.skin + a.axis, q.port.insertion_mm, to_deformed(), Vec3(0, 0, 1));
+  const ViewCamera camera = make_view_camera(pose, q.port.optics, q.width, q.height);
   const RenderImage image = renderer_.render(camera, settings_from_scene(scene_.render, volume_->geometry));
   RgbImage rgb(image.width, image.height);
   rgb.rgb = to_rgb8(image);
@@ -357,7 +338,7 @@ std::string PlanningSession::slices_png() {
   return encode_png(stack_rows({before, render_slice_row(after, nullptr, view)}));
 }
 
-nlohmann::json PlanningSession::plan_json(const std::vector<std::pair<std::string, ScopeRequest>>& ports) const {
+nlohmann::json PlanningSession::plan_json(const std::vector<ScopeRequest>& ports) const {
   nlohmann::json j = scene_json_;
   j["load"]["pressure_mmhg"] = scene_.load.pressure_mmhg;
   j["load"].erase("pressure_curve_mmhg");   // the page solves one pressure; so does its plan
@@ -367,16 +348,24 @@ nlohmann::json PlanningSession::plan_json(const std::vector<std::pair<std::strin
     if (settings_.preset) j["preset"] = *settings_.preset;
   }
   nlohmann::json list = nlohmann::json::array();
-  for (const auto& [name, q] : ports) {
-    nlohmann::json p = {{"name", name},
-                        {"skin_point_mm", {q.skin_point_mm.x(), q.skin_point_mm.y(), q.skin_point_mm.z()}},
-                        {"insertion_mm", q.insertion_mm},
-                        {"fov_deg", q.fov_deg},
-                        {"oblique_deg", q.oblique_deg},
-                        {"roll_deg", q.roll_deg}};
-    if (q.target_label) p["target_label"] = *q.target_label;
-    else if (q.target_mm) p["target_mm"] = {q.target_mm->x(), q.target_mm->y(), q.target_mm->z()};
-    list.push_back(p);
+  for (const ScopeRequest& q : ports) {
+    Port p = q.port;
+    if (q.yaw_deg != 0.0 || q.pitch_deg != 0.0) {
+      // The dragged axis as a target point on the CT as given: the first point along it, from the
+      // target's distance on, that a tetrahedron carries (the gas in front of tissue is carried by
+      // none). It travels with that tissue, as a scene's target_mm does.
+      const Aim a = aim(q);
+      const double step = 0.5 * volume_->geometry.spacing_mm.minCoeff(), length = a.axis.norm();
+      std::optional<Vec3> on_ct;
+      for (double t = length; t <= 3.0 * length && !on_ct; t += step) {
+        const MappedPoint back = point_map_->to_original(a.skin + t / length * a.axis);
+        if (back.carried) on_ct = back.point_mm;
+      }
+      if (!on_ct) throw InputError(p.name + ": the dragged aim leaves the body without meeting tissue; aim again");
+      p.target_mm = on_ct;
+      p.target_label.reset();
+    }
+    list.push_back(port_json(p));
   }
   j["render"]["ports"] = list;
   return j;

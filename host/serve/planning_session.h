@@ -40,15 +40,13 @@ struct InflateRequest {
   std::optional<std::string> preset;      // "preview", "balanced", "accurate"
 };
 
-/// A laparoscope at a port: the skin point on the CT as given (it travels with the skin), the
-/// target (an organ label's centroid, or a point on the CT as given), and the scope's optics.
-/// yaw and pitch turn the axis from the target about the skin point (degrees; dragging aims).
+/// A laparoscope at a port: the scene's own Port (its skin point on the CT as given, which travels
+/// with the skin; its target, an organ label's centroid or a point on the CT as given; insertion and
+/// optics), read with a scene port's checks (read_port), and the aim the user dragged: yaw and pitch
+/// turn the axis from the target about the skin point (degrees).
 struct ScopeRequest {
-  Vec3 skin_point_mm = Vec3::Zero();
-  std::optional<int> target_label;
-  std::optional<Vec3> target_mm;
-  double insertion_mm = 60.0, fov_deg = 70.0, oblique_deg = 30.0, roll_deg = 0.0;
-  double yaw_deg = 0.0, pitch_deg = 0.0;
+  Port port;
+  double yaw_deg = 0.0, pitch_deg = 0.0;   // ±180, ±89
   int width = 480, height = 360;
 };
 
@@ -96,8 +94,11 @@ class PlanningSession {
   /// candidates (candidates_total says how many there were). Kept for exterior_png's heat map.
   nlohmann::json rank_ports(int target_label, const std::vector<Vec3>& placed_ports_mm, double grid_mm, int top);
 
-  /// The scene as it now stands (the file's text with the changes made), to save as a plan.
-  nlohmann::json plan_json(const std::vector<std::pair<std::string, ScopeRequest>>& ports) const;
+  /// The scene as it now stands (the file's text with the changes made), to save as a plan, with
+  /// `ports` as its render.ports. A port whose aim was dragged aims at a point on the dragged axis
+  /// instead of its target (the scene's ports aim at a target); InputError when that axis leaves
+  /// the body without meeting tissue the shape carries.
+  nlohmann::json plan_json(const std::vector<ScopeRequest>& ports) const;
 
   /// Thread-safe: the settings, the solve's progress and the last equilibrium's figures.
   nlohmann::json status() const;
@@ -113,6 +114,13 @@ class PlanningSession {
   nlohmann::json scene_ports() const;   // the scene's ports, for the page to start from
   nlohmann::json label_list() const;    // the label map's ids with their names, for the targets
   PointMapFn to_deformed() const;
+  /// The scope's axis in the deformed frame: from the port's skin point to its target, turned by
+  /// the dragged yaw (about the superior axis) and pitch (about the axis's right). InputError for an
+  /// unknown label or a target on the skin point.
+  struct Aim {
+    Vec3 skin = Vec3::Zero(), axis = Vec3::Zero();   // axis: skin → the (turned) target, full length
+  };
+  Aim aim(const ScopeRequest& q) const;
 
   nlohmann::json scene_json_;
   std::string scene_path_;

@@ -17,8 +17,9 @@ function newPort(name, skin) {
 }
 
 function selectPort(k) {
-  state.selected = k; state.yaw = 0; state.pitch = 0;
+  state.selected = k;
   const p = state.ports[k];
+  state.yaw = p.yaw_deg || 0; state.pitch = p.pitch_deg || 0;   // each port keeps its dragged aim
   for (const [id, key] of Object.entries(OPTICS)) $(id).value = p[key];
   $("target").value = p.target_label !== null && p.target_label !== undefined ? p.target_label : "point";
   showOutputs(); showPorts(); refreshScope();
@@ -162,6 +163,7 @@ window.addEventListener("mousemove", (ev) => {
   if (!drag) return;
   state.yaw = Math.max(-180, Math.min(180, drag.yaw - (ev.clientX - drag.x) * 0.3));
   state.pitch = Math.max(-89, Math.min(89, drag.pitch + (ev.clientY - drag.y) * 0.3));
+  if (state.selected >= 0) Object.assign(state.ports[state.selected], { yaw_deg: state.yaw, pitch_deg: state.pitch });
   refreshScope();
 });
 
@@ -215,10 +217,12 @@ $("rank").addEventListener("click", async () => {
 });
 $("plan").addEventListener("click", async () => {
   if (!state.ports.length) { setStatus("place a port on the skin first", true); return; }
+  // Each port as the scene writes it (from /api/case, or placed here), its dragged aim beside it:
+  // the server reads it as a scene's port and turns the aim into a target point.
   const ports = state.ports.map((p) => {
-    const q = { skin_point_mm: p.skin_point_mm, insertion_mm: p.insertion_mm, fov_deg: p.fov_deg,
-                oblique_deg: p.oblique_deg, roll_deg: p.roll_deg };
-    if (p.target_label) q.target_label = p.target_label; else q.target_mm = p.target_mm;
+    const q = Object.assign({}, p, { yaw_deg: p.yaw_deg || 0, pitch_deg: p.pitch_deg || 0 });
+    delete q.name;
+    if (q.target_label) delete q.target_mm; else delete q.target_label;
     return q;
   });
   try { await post("/api/plan", { ports }); } catch (e) { setStatus(e.message, true); }
