@@ -190,14 +190,20 @@ WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labe
   }
   w.outside_grid_mm = worst;
   if (worst >= w.output_grid.spacing_mm.maxCoeff()) {
-    const char* key = side == 'A' ? "roles.pad_anterior_mm" : side == 'S' ? "roles.pad_superior_mm"
-                    : side == 'I' ? "roles.pad_inferior_mm" : (side == 'R' || side == 'L') ? "roles.pad_lateral_mm"
-                                                                                              : "the field of view";
-    char msg[320];
-    std::snprintf(msg, sizeof msg,
-                  "warp: the deformed body reaches %.1f mm beyond the output grid (side %c) and is clipped there; "
-                  "raise %s%s",
-                  worst, side, key, working ? "" : " and set output.grid to \"working\"");
+    // The working grid grows to hold the body up to kMaxGridGrowthMm on each side: beyond that the
+    // wall moved farther than an abdomen does, which a diverged or mis-set solve does, not padding.
+    char msg[400];
+    if (working)
+      std::snprintf(msg, sizeof msg,
+                    "warp: the deformed body reaches %.1f mm beyond the output grid (side %c), which grew by up to "
+                    "%.0f mm to hold it, and is clipped there; no abdomen moves that far: check the solve's "
+                    "convergence, load.pressure_mmhg and the wall's stiffness",
+                    worst, side, kMaxGridGrowthMm);
+    else
+      std::snprintf(msg, sizeof msg,
+                    "warp: the deformed body reaches %.1f mm beyond the CT's grid (side %c) and is clipped there; "
+                    "set output.grid to \"working\" to grow the output around the deformed body",
+                    worst, side);
     log::warn(msg);
   }
   return w;
