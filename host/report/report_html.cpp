@@ -1,4 +1,6 @@
 #include "report/report_html.h"
+
+#include "core/mime_type.h"
 #include "report/markup.h"
 #include "report/metric_names.h"
 
@@ -21,11 +23,6 @@ bool read_file(const std::string& path, std::string& bytes) {
   ss << in.rdbuf();
   bytes = ss.str();
   return bool(in) || in.eof();
-}
-
-std::string mime_of(const std::string& path) {
-  const std::string ext = path.substr(path.find_last_of('.') + 1);
-  return ext == "jpg" || ext == "jpeg" ? "image/jpeg" : "image/png";
 }
 
 std::string number(double d) {
@@ -58,7 +55,7 @@ std::string with_unit(const json& v, const MetricName& n) {
 std::string img_tag(const std::string& path, const std::string& alt) {
   std::string bytes;
   if (!read_file(path, bytes) || bytes.empty()) return "<p class=\"warn\">missing: " + escape_markup(path) + "</p>";
-  return "<img alt=\"" + escape_markup(alt) + "\" src=\"data:" + mime_of(path) + ";base64," + base64(bytes) + "\">";
+  return "<img alt=\"" + escape_markup(alt) + "\" src=\"data:" + mime_type_of(path) + ";base64," + base64(bytes) + "\">";
 }
 
 void figure(const ReportImage& im, std::ostringstream& o) {
@@ -149,7 +146,7 @@ void animation(const ReportAnimation& a, int index, std::ostringstream& o) {
   // Shown at twice the strip's frame size; steps(N) jumps frame by frame from 0 to −(N−1)·w.
   const int w = 2 * a.frame_width, h = 2 * a.frame_height, n = a.frames;
   const std::string cls = "strip" + std::to_string(index);
-  o << "<style>." << cls << "{background-image:url(data:" << mime_of(a.strip_path) << ";base64," << base64(bytes)
+  o << "<style>." << cls << "{background-image:url(data:" << mime_type_of(a.strip_path) << ";base64," << base64(bytes)
     << ");background-repeat:no-repeat}@keyframes play" << index << "{from{background-position:0 0}to{background-position:-"
     << int64_t(n) * w << "px 0}}</style>\n";
   o << "<div class=\"" << cls << " player\" role=\"img\" aria-label=\"" << escape_markup(a.title) << "\" style=\"width:" << w

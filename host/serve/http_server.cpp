@@ -20,6 +20,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/mime_type.h"
 #include "render/gl_context.h"
 #include "scene/scene.h"
 #include "serve/embedded_page.h"
@@ -42,13 +43,6 @@ nlohmann::json read_scene_json(const std::string& path) {
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path + ": not valid JSON (" + e.what() + ")");
   }
-}
-
-const char* content_type(const std::string& path) {
-  if (path.size() >= 5 && path.compare(path.size() - 5, 5, ".html") == 0) return "text/html; charset=utf-8";
-  if (path.size() >= 3 && path.compare(path.size() - 3, 3, ".js") == 0) return "text/javascript; charset=utf-8";
-  if (path.size() >= 4 && path.compare(path.size() - 4, 4, ".css") == 0) return "text/css; charset=utf-8";
-  return "application/octet-stream";
 }
 
 /// A whole number in [lo, hi] (image sizes, label ids): checked on the double, before any cast.
@@ -343,7 +337,7 @@ void Server::Impl::routes() {
   for (const EmbeddedPageFile& f : embedded_page()) {
     const std::string route = std::string("/") + (std::string(f.path) == "index.html" ? "" : f.path);
     const std::string* text = &f.source;
-    const char* type = content_type(f.path);
+    const char* type = mime_type_of(f.path);
     http.Get(route, [text, type](const httplib::Request&, httplib::Response& res) { res.set_content(*text, type); });
   }
 
