@@ -8,20 +8,20 @@ namespace pneumo::cli {
 
 Run add_serve(CLI::App& app) {
   auto* cmd = app.add_subcommand(
-      "serve", "A local web page over one case: re-inflate, aim the laparoscope, place ports on the skin (issue 22)");
-  struct Opts { std::string scene, host = "127.0.0.1", out = "out/serve", backend = "auto"; int port = 8080; };
+      "serve", "A local web page over one case: re-inflate, aim the laparoscope, rank and place ports on the skin");
+  // The options' defaults are ServeOptions' own (the help shows them).
+  struct Opts { serve::ServeOptions serve; std::string backend = "auto"; };
   auto o = std::make_shared<Opts>();
-  cmd->add_option("scene", o->scene, "Scene .json: the case, loaded once")->required();
-  cmd->add_option("--host", o->host, "Address to listen on (default 127.0.0.1: this machine only)");
-  cmd->add_option("--port", o->port, "Port to listen on; 0 picks a free one")->check(CLI::Range(0, 65535));
-  cmd->add_option("--out", o->out, "Folder for the plans the page saves and their reports");
+  cmd->add_option("scene", o->serve.scene_path, "Scene .json: the case, loaded once")->required();
+  cmd->add_option("--host", o->serve.host, "Address to listen on (127.0.0.1: this machine only)")->capture_default_str();
+  cmd->add_option("--port", o->serve.port, "Port to listen on; 0 picks a free one")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
+  cmd->add_option("--out", o->serve.out_dir, "Folder for the plans the page saves and their reports")
+      ->capture_default_str();
   cmd->add_option("--backend", o->backend, "Offscreen OpenGL: auto, egl-device, egl-surfaceless or osmesa");
   return [=] {
-    serve::ServeOptions opt;
-    opt.scene_path = o->scene;
-    opt.host = o->host;
-    opt.port = o->port;
-    opt.out_dir = o->out;
+    serve::ServeOptions opt = o->serve;
     opt.backend = parse_gl_backend(o->backend);
     return serve::serve_until_signalled(opt);
   };
