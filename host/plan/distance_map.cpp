@@ -58,6 +58,7 @@ void squared_distance_1d(const double* f, double* d, int64_t n, double h, std::v
 
 std::vector<float> distance_to_mask_mm(const std::vector<uint8_t>& mask, const Geometry& g) {
   if (int64_t(mask.size()) != g.voxel_count()) throw std::invalid_argument("distance_to_mask_mm: mask size");
+  if (mask.empty()) return {};
   const int64_t nx = g.dims[0], ny = g.dims[1];
   // Squared distances in float (4 bytes a voxel on clinical grids); each line's envelope in double.
   std::vector<float> d2(mask.size());

@@ -1,6 +1,7 @@
 #include "plan/port_ranking.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -17,6 +18,9 @@ constexpr double kDeg = 180.0 / M_PI;
 
 /// Exposed target points a candidate's path may aim at when the path to the centroid is closed.
 constexpr std::size_t kAimTries = 48;
+/// A label is one of the wall's layers when at least this many paths, and half of those reaching
+/// the gas, cross it before the gas: a rib that one path meets is an obstacle, not a layer.
+constexpr int kMinWallVotes = 3;
 
 /// 0 at a, rising linearly to 1 at b (a < b), 1 beyond.
 double ramp_up(double v, double a, double b) { return std::clamp((v - a) / (b - a), 0.0, 1.0); }
@@ -50,6 +54,7 @@ struct PathWalk {
   PortProblem problem = PortProblem::None;
   int blocking_label = 0;
   std::vector<int> wall_labels;   // the labels crossed between the skin and the gas (distinct)
+  bool reached_gas = false;
   Vec3 gas_entry = Vec3::Zero(), target_hit = Vec3::Zero();
   double wall_mm = 0.0;
 };
@@ -58,7 +63,13 @@ PathWalk walk_path(const Grid& grid, const Vec3& skin, const Vec3& aim, int targ
   PathWalk w;
   const Vec3 dir = (aim - skin).normalized();
   const double length = (aim - skin).norm();
-  const double block_mm = kBlockToleranceVoxels * grid.g.spacing_mm.maxCoeff();
+  // A voxel's extent along the path (its box's width in that direction): the tolerance follows the
+  // voxels the path crosses, not the coarsest spacing (a 0.7×0.7×5 mm CT crossed in-plane).
+  const Vec3 index_dir = grid.g.direction.transpose() * dir;
+  const double voxel_along = std::abs(index_dir.x()) * grid.g.spacing_mm.x() +
+                             std::abs(index_dir.y()) * grid.g.spacing_mm.y() +
+                             std::abs(index_dir.z()) * grid.g.spacing_mm.z();
+  const double block_mm = kBlockToleranceVoxels * voxel_along;
   bool in_gas = false;
   double tissue_run_mm = 0.0;
   int tissue_label = 0;
@@ -68,6 +79,7 @@ PathWalk walk_path(const Grid& grid, const Vec3& skin, const Vec3& aim, int targ
     if (!in_gas) {
       if (l == gas) {
         in_gas = true;
+        w.reached_gas = true;
         w.gas_entry = p;
         w.wall_mm = t;
         continue;
@@ -264,46 +276,67 @@ PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometr
         if (ct_hu[v] < o.skin_hu) continue;
         std::array<int64_t, 3> idx{};
         idx[std::size_t(f.lat)] = l, idx[std::size_t(f.ap)] = a, idx[std::size_t(f.si)] = s;
-        skins.push_back(g.to_world(Vec3(double(idx[0]), double(idx[1]), double(idx[2]))));
+        const Vec3 skin = g.to_world(Vec3(double(idx[0]), double(idx[1]), double(idx[2])));
+        if (skin.y() > r.target_centroid_mm.y()) skins.push_back(skin);   // y: anterior (RAS)
         break;
       }
   if (skins.empty()) throw InputError("no skin found (no voxel at or above " + std::to_string(o.skin_hu) + " HU)");
 
-  // Pass 1: the paths. The wall's own layers are the labels that most trocars reaching the gas cross.
+  // Pass 1: the wall's own layers, the labels that most trocars cross on their way to the gas (the
+  // straight paths to the centroid that reach it; at least kMinWallVotes of them).
   const Grid grid{labels, g, 0.5 * g.spacing_mm.minCoeff()};
-  std::vector<PathWalk> walks(skins.size());
-  std::vector<Vec3> aim_of(skins.size(), r.target_aim_mm);
+  std::vector<PathWalk> to_centre(skins.size());
 #pragma omp parallel for schedule(dynamic, 4)
-  for (int64_t c = 0; c < int64_t(skins.size()); ++c) {
-    // The exposed points by their angle from the line to the centroid: the first open path wins; a
-    // candidate with none keeps the problem of the path to the centroid.
-    const Vec3 skin = skins[std::size_t(c)];
-    const Vec3 to_centre = (r.target_aim_mm - skin).normalized();
-    std::vector<std::pair<double, std::size_t>> order;
-    for (std::size_t a = 0; a < aims.size(); ++a) order.push_back({-(aims[a] - skin).normalized().dot(to_centre), a});
-    std::sort(order.begin(), order.end());
-    PathWalk& w = walks[std::size_t(c)];
-    w = walk_path(grid, skin, r.target_aim_mm, target, gas, o.max_wall_mm);
-    for (std::size_t t = 0; w.problem != PortProblem::None && t < order.size() && t < kAimTries; ++t) {
-      PathWalk tried = walk_path(grid, skin, aims[order[t].second], target, gas, o.max_wall_mm);
-      if (tried.problem == PortProblem::None) {
-        w = std::move(tried);
-        aim_of[std::size_t(c)] = aims[order[t].second];
-      }
-    }
-  }
+  for (int64_t c = 0; c < int64_t(skins.size()); ++c)
+    to_centre[std::size_t(c)] = walk_path(grid, skins[std::size_t(c)], r.target_aim_mm, target, gas, o.max_wall_mm);
   std::map<int, int> crossed;
   int reaching = 0;
-  for (const PathWalk& w : walks) {
-    if (w.problem != PortProblem::None) continue;
+  for (const PathWalk& w : to_centre) {
+    if (!w.reached_gas) continue;
     ++reaching;
     for (int l : w.wall_labels) ++crossed[l];
   }
   for (const auto& [l, count] : crossed)
-    if (2 * count >= reaching) r.wall_layer_labels.push_back(l);
+    if (count >= kMinWallVotes && 2 * count >= reaching) r.wall_layer_labels.push_back(l);
   const auto is_wall_layer = [&](int l) {
     return std::find(r.wall_layer_labels.begin(), r.wall_layer_labels.end(), l) != r.wall_layer_labels.end();
   };
+  // A path is open when it reaches the target through gas and crosses nothing but the wall's layers
+  // before the gas.
+  const auto open = [&](PathWalk& w) {
+    if (w.problem != PortProblem::None) return false;
+    for (int l : w.wall_labels)
+      if (!is_wall_layer(l)) {
+        w.problem = PortProblem::CrossesOrgan;
+        w.blocking_label = l;
+        return false;
+      }
+    return true;
+  };
+
+  // Pass 2: each candidate's path: to the centroid when open, else to the exposed point nearest that
+  // line whose path is open; a candidate with none keeps the problem of the path to the centroid.
+  std::vector<PathWalk> walks(skins.size());
+  std::vector<Vec3> aim_of(skins.size(), r.target_aim_mm);
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int64_t c = 0; c < int64_t(skins.size()); ++c) {
+    const Vec3 skin = skins[std::size_t(c)];
+    PathWalk& w = walks[std::size_t(c)];
+    w = to_centre[std::size_t(c)];
+    if (open(w)) continue;
+    const Vec3 centre_dir = (r.target_aim_mm - skin).normalized();
+    std::vector<std::pair<double, std::size_t>> order;
+    for (std::size_t a = 0; a < aims.size(); ++a) order.push_back({-(aims[a] - skin).normalized().dot(centre_dir), a});
+    std::sort(order.begin(), order.end());
+    for (const auto& [cos_neg, a] : order) {
+      PathWalk tried = walk_path(grid, skin, aims[a], target, gas, o.max_wall_mm);
+      if (open(tried)) {
+        w = std::move(tried);
+        aim_of[std::size_t(c)] = aims[a];
+        break;
+      }
+    }
+  }
 
   // The obstacles: every other labelled structure; their distance map gives each path's clearance.
   std::vector<uint8_t> obstacle(std::size_t(n), 0);
@@ -323,13 +356,6 @@ PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometr
     c.skin_mm = skins[std::size_t(ci)];
     c.problem = w.problem;
     c.blocking_label = w.blocking_label;
-    if (c.feasible())
-      for (int l : w.wall_labels)
-        if (!is_wall_layer(l)) {
-          c.problem = PortProblem::CrossesOrgan;
-          c.blocking_label = l;
-          break;
-        }
     c.aim_mm = aim_of[std::size_t(ci)];
     const Vec3 axis = (c.aim_mm - c.skin_mm).normalized();
     c.elevation_deg = std::asin(std::min(1.0, std::abs(axis.y()))) * kDeg;   // y: anterior, the vertical when supine
