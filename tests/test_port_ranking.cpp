@@ -91,16 +91,44 @@ TEST(PortRanking, ThePortOverTheTargetReachesItThroughTheWallAndTheGas) {
   // The plate's edge (i = 27) is 3 voxels from the path's column: 6 mm where the path passes it.
   EXPECT_NEAR(c->clearance_mm, 6.0, 0.35);   // 6.3 mm one voxel higher, where the march may sample last
   EXPECT_EQ(c->nearest_label, kPlate);
-  // The scope's tip 7 mm into the gas (half of its 14 mm) sees the 8 mm sphere from 15.5 mm: under
-  // asin(8/15.5) = 31°, inside the 35° half angle, with nothing between: all of it.
-  EXPECT_DOUBLE_EQ(c->visible_fraction, 1.0);
-  // A 30° scope sees only the directions within 15° of its axis.
+  // The scope's tip 7 mm into the gas (half of its 14 mm) looks down on the sphere's cap that rises
+  // into the gas, the only part of it any scope can see: all of it is in sight, and no candidate
+  // sees more.
+  ASSERT_GT(r.exposed_voxels, 0);
+  EXPECT_DOUBLE_EQ(c->visible_fraction, double(r.exposed_voxels) / double(r.surface_voxels));
+  EXPECT_DOUBLE_EQ(c->t_visibility, 1.0);
+  // A 10° scope sees only the directions within 5° of its axis: part of the cap.
   PortRankOptions narrow = options();
-  narrow.fov_deg = 30.0;
+  narrow.fov_deg = 10.0;
   const PortCandidate* n = candidate_at(rank_ports(w.labels.data(), w.hu.data(), w.g, narrow), w.voxel(30, 44, 30));
   ASSERT_NE(n, nullptr);
-  EXPECT_GT(n->visible_fraction, 0.05);
-  EXPECT_LT(n->visible_fraction, 0.95);
+  EXPECT_GT(n->visible_fraction, 0.0);
+  EXPECT_LT(n->visible_fraction, c->visible_fraction);
+}
+
+TEST(PortRanking, VisibilityCountsOnlyTheSurfaceInSight) {
+  // The sphere alone in gas under the wall, all its surface facing the gas: from a point at distance
+  // d from its centre a sphere of radius r shows the cap whose share of its area is (1 − r/d)/2,
+  // never its far side.
+  BoxWorld w;
+  for (int64_t k = 0; k < 60; ++k)
+    for (int64_t j = 0; j < 40; ++j)
+      for (int64_t i = 0; i < 60; ++i) {
+        const std::size_t n = std::size_t(w.g.linear_index(i, j, k));
+        if (w.labels[n] != kTarget) w.labels[n] = kGas, w.hu[n] = -1000.0f;
+      }
+  const PortRanking r = rank_ports(w.labels.data(), w.hu.data(), w.g, options());
+  const PortCandidate* c = candidate_at(r, w.voxel(30, 44, 30));
+  ASSERT_NE(c, nullptr);
+  ASSERT_TRUE(c->feasible()) << port_problem_name(c->problem);
+  // The tip: 20 mm into the gas or halfway to the target, whichever is less (port_ranking.h).
+  const double in_gas = c->skin_to_target_mm - c->wall_mm;
+  const Vec3 eye = c->gas_entry_mm + std::min(20.0, 0.5 * in_gas) * Vec3(0, -1, 0);
+  const double d = (eye - r.target_centroid_mm).norm();
+  const double cap = 0.5 * (1.0 - 8.0 / d);
+  // The samples are the surface voxels of a sphere 4 voxels in radius: within 0.05 of the cap's share
+  // (0.246 against 0.233 here).
+  EXPECT_NEAR(c->visible_fraction, cap, 0.05) << "tip " << d << " mm from the centre";
 }
 
 TEST(PortRanking, APlateInTheGasBlocksThePathsItShades) {
@@ -121,7 +149,9 @@ TEST(PortRanking, APlateInTheGasBlocksThePathsItShades) {
   for (std::size_t n = 0; n < r.candidates.size(); ++n) {
     if (!r.candidates[n].feasible()) seen_infeasible = true;
     else EXPECT_FALSE(seen_infeasible) << "a feasible port after an infeasible one";
-    if (n > 0 && r.candidates[n].feasible()) EXPECT_LE(r.candidates[n].score, r.candidates[n - 1].score);
+    if (n > 0 && r.candidates[n].feasible()) {
+      EXPECT_LE(r.candidates[n].score, r.candidates[n - 1].score);
+    }
   }
 }
 

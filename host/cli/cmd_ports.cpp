@@ -60,6 +60,10 @@ Run add_ports(CLI::App& app) {
       std::printf("ports for %s (label %d): %d of %zu candidates feasible; best first:\n",
                   t["target"]["name"].get<std::string>().c_str(), o->target, t["feasible_candidates"].get<int>(),
                   t["candidates"].size());
+      const double exposed = t["target"]["exposed_voxels"].get<double>(), surface = t["target"]["surface_voxels"].get<double>();
+      if (exposed < 0.05 * surface)
+        std::printf("  only %.0f of its %.0f surface voxels (%.1f %%) face the gas: the rest needs retraction, which the "
+                    "model does not do\n", exposed, surface, 100.0 * exposed / surface);
       std::printf("  rank  score  visible  clearance  to target  elevation  skin point on the CT (mm)\n");
       for (const auto& c : t["candidates"]) {
         if (!c["feasible"].get<bool>() || c["rank"].get<int>() > 5) break;

@@ -47,6 +47,7 @@ nlohmann::json port_ranking_json(const PortRanking& r, const PortRankOptions& o,
   j["target"] = {{"label", o.target_label},
                  {"name", name_of(names, o.target_label)},
                  {"voxels", r.target_voxels},
+                 {"surface_voxels", r.surface_voxels},
                  {"exposed_voxels", r.exposed_voxels},
                  {"centroid_deformed_mm", vec_json(r.target_centroid_mm)},
                  {"aim_deformed_mm", vec_json(r.target_aim_mm)}};

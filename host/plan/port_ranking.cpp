@@ -117,12 +117,15 @@ PathWalk walk_path(const Grid& grid, const Vec3& skin, const Vec3& aim, int targ
   return w;
 }
 
-/// The fraction of `samples` (target surface points) a scope at `eye` looking along `axis` sees:
-/// within the half angle of its field of view, and the first non-gas voxel on the way is the target.
+/// The fraction of `samples` (target surface voxels' centres) a scope at `eye` looking along `axis`
+/// sees: within the half angle of its field of view, with nothing but gas before the ray reaches the
+/// sample's own voxel (the first non-gas point lies within a voxel of it). Samples behind other
+/// organs, and those on the target's far or buried side (behind its own front), are not seen.
 double visible_fraction(const Grid& grid, const Vec3& eye, const Vec3& axis, double half_fov_rad,
                         const std::vector<Vec3>& samples, int target, int gas) {
   if (samples.empty()) return 0.0;
   const double cos_half = std::cos(half_fov_rad);
+  const double reach = grid.g.spacing_mm.maxCoeff() + grid.step_mm;   // the sample's voxel, entered at a corner
   int64_t seen = 0;
   for (const Vec3& q : samples) {
     const Vec3 v = q - eye;
@@ -136,7 +139,7 @@ double visible_fraction(const Grid& grid, const Vec3& eye, const Vec3& axis, dou
     for (double t = 0.0; t <= d + grid.step_mm; t += grid.step_mm) {
       const int l = grid.label_at(eye + std::min(t, d) * u);
       if (l == gas) continue;
-      if (l == target) ++seen;
+      if (l == target && d - t <= reach) ++seen;
       break;
     }
   }
@@ -250,20 +253,26 @@ PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometr
     if (probe.label_at(r.target_centroid_mm) == target) r.target_aim_mm = r.target_centroid_mm;
   }
   r.exposed_voxels = int64_t(exposed.size());
-  // The points an instrument may aim at: the exposed surface, nearest the centroid first (at most
-  // kAimTries of them, evenly spread), so a path reaches the target's middle where it can.
+  r.surface_voxels = int64_t(surface.size());
+  const double exposed_share = surface.empty() ? 0.0 : double(exposed.size()) / double(surface.size());
+  // The points an instrument may aim at when the path to the centroid is closed: the exposed
+  // surface, at most kAimTries voxels of it evenly spread (each candidate tries them nearest its
+  // line to the centroid first).
   std::vector<Vec3> aims;
   {
     const std::size_t count = std::min<std::size_t>(exposed.size(), kAimTries);
     for (std::size_t s = 0; s < count; ++s) aims.push_back(world_of(exposed[s * exposed.size() / count]));
   }
+  // What visibility is measured on: the target's surface that faces the gas, the only part any
+  // scope can see (the rest lies against other tissue), at most target_samples voxels evenly spread.
   std::vector<Vec3> samples;
   {
-    const std::size_t count = std::min<std::size_t>(surface.size(), std::size_t(std::max(o.target_samples, 1)));
-    for (std::size_t s = 0; s < count; ++s) samples.push_back(world_of(surface[s * surface.size() / count]));
+    const std::size_t count = std::min<std::size_t>(exposed.size(), std::size_t(std::max(o.target_samples, 1)));
+    for (std::size_t s = 0; s < count; ++s) samples.push_back(world_of(exposed[s * exposed.size() / count]));
   }
 
-  // The candidates: the anterior skin, one point per grid_mm laterally and cranio-caudally.
+  // The candidates: the anterior skin, one point per grid_mm laterally and cranio-caudally, in
+  // front of the target's centroid (beside the body the first solid voxel is the couch beneath).
   const SliceFrame f = slice_frame(g);
   const int64_t step_lat = std::max<int64_t>(1, std::llround(o.grid_mm / f.h_lat));
   const int64_t step_si = std::max<int64_t>(1, std::llround(o.grid_mm / f.h_si));
@@ -365,7 +374,8 @@ PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometr
     c.skin_to_target_mm = (w.target_hit - c.skin_mm).norm();
     const double in_gas = (w.target_hit - w.gas_entry).norm();
     const Vec3 eye = w.gas_entry + std::min(o.eye_depth_mm, 0.5 * in_gas) * axis;
-    c.visible_fraction = visible_fraction(grid, eye, axis, half_fov, samples, target, gas);
+    // Of the gas-facing surface sampled, the share seen, as a share of the whole surface.
+    c.visible_fraction = visible_fraction(grid, eye, axis, half_fov, samples, target, gas) * exposed_share;
     // Clearance along the path in the gas, short of the target's own neighbourhood (the last 10 mm,
     // where the instrument works on the target and touches what lies beside it).
     c.clearance_mm = std::numeric_limits<double>::infinity();
@@ -386,16 +396,25 @@ PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometr
       if (std::isnan(c.manipulation_deg) || manipulation_term(angle) > manipulation_term(c.manipulation_deg))
         c.manipulation_deg = angle;
     }
-    c.t_visibility = visibility_term(c.visible_fraction);
     c.t_clearance = clearance_term(c.clearance_mm);
     c.t_distance = distance_term(c.skin_to_target_mm);
     c.t_elevation = elevation_term(c.elevation_deg);
-    const PortRankWeights& wt = o.weights;
+    if (!o.other_ports_mm.empty())
+      c.t_triangulation = spacing_term(c.spacing_mm) * manipulation_term(c.manipulation_deg);
+  }
+  // Visibility against the best port's: how much of what any candidate sees this one sees, so the
+  // term weighs the same whether the organ shows a tenth of its surface to the gas or all of it.
+  double best_visible = 0.0;
+  for (const PortCandidate& c : r.candidates)
+    if (c.feasible()) best_visible = std::max(best_visible, c.visible_fraction);
+  const PortRankWeights& wt = o.weights;
+  for (PortCandidate& c : r.candidates) {
+    if (!c.feasible()) continue;
+    c.t_visibility = best_visible > 0.0 ? visibility_term(c.visible_fraction / best_visible) : 0.0;
     double num = wt.visibility * c.t_visibility + wt.clearance * c.t_clearance + wt.distance * c.t_distance +
                  wt.elevation * c.t_elevation;
     double den = wt.visibility + wt.clearance + wt.distance + wt.elevation;
     if (!o.other_ports_mm.empty()) {
-      c.t_triangulation = spacing_term(c.spacing_mm) * manipulation_term(c.manipulation_deg);
       num += wt.triangulation * c.t_triangulation;
       den += wt.triangulation;
     }

@@ -3,16 +3,20 @@
 // surgeon weighs when choosing where a trocar goes, measured on the deformed labels and CT.
 //
 // Candidates lie on a regular grid over the anterior skin (the first voxel at or above skin_hu,
-// the exterior views' iso-surface, seen from in front along each axial column). Each is judged on
+// the exterior views' iso-surface, seen from in front along each axial column), in front of the
+// target's centroid. Each is judged on
 // the straight path of an instrument from its skin point to the target: to the target's centroid
 // (or the target voxel nearest it) when that path is open, else to the point of the target's
 // gas-facing surface nearest that line whose path is open (an organ is worked on where it faces
 // the gas):
 //   - feasible: the path reaches the gas within a trocar's length (max_wall_mm) crossing only the
-//     wall's own layers, and runs through gas to the target with no organ in between (more than
-//     kBlockToleranceVoxels of other tissue is a blocked path);
-//   - visibility: the fraction of the target's surface a scope at the port sees unoccluded, its tip
-//     eye_depth_mm into the gas, aimed along the path, within its field of view;
+//     wall's own layers, and runs through gas to the target with no organ in between (a run of
+//     other tissue longer than kBlockToleranceVoxels voxels along the path blocks it);
+//   - visibility: the share of the target's surface voxels that a scope at the port sees, its tip
+//     eye_depth_mm into the gas, aimed along the path: within its field of view, nothing but gas
+//     before the ray reaches the voxel (neither another organ nor the target's own front). Only the
+//     gas-facing surface can be seen, so that is what is sampled; the term is this share against
+//     the best candidate's;
 //   - clearance: the smallest distance from the path in the gas to another labelled structure (an
 //     organ, a vessel, bone; the wall's own layers excepted);
 //   - distance: skin to target along the path, against Emam, Hanna & Cuschieri 2000 (Arch Surg 135:
@@ -48,7 +52,7 @@ struct PortRankOptions {
   double eye_depth_mm = 20.0;    // the scope's tip beyond the gas entry (at most halfway to the target)
   double max_wall_mm = 100.0;    // a standard trocar's working length: a thicker wall is not crossed
   double skin_hu = -500.0;       // the skin's iso-value (pipeline/exterior_views.h)
-  int target_samples = 400;      // target surface voxels tested for visibility (evenly spread)
+  int target_samples = 400;      // gas-facing target voxels tested for visibility (evenly spread)
   std::vector<Vec3> other_ports_mm;   // skin points of ports already placed, deformed frame
   PortRankWeights weights;
 };
@@ -56,8 +60,8 @@ struct PortRankOptions {
 /// Why a candidate cannot serve as a port.
 enum class PortProblem {
   None,
-  NoGas,          // the path meets no gas before the target or within max_wall_mm
-  WallTooThick,   // the gas lies deeper than max_wall_mm
+  NoGas,          // the path meets the target before any gas
+  WallTooThick,   // no gas within max_wall_mm of the skin (deeper, or none on the path)
   CrossesOrgan,   // the trocar would cross a labelled structure (blocking_label) before the gas
   Blocked,        // a structure (blocking_label; 0: unlabelled tissue) lies between the gas and the target
 };
@@ -70,7 +74,7 @@ struct PortCandidate {
   PortProblem problem = PortProblem::None;
   int blocking_label = 0;
   double score = 0.0;
-  double visible_fraction = 0.0;
+  double visible_fraction = 0.0;      // of the target's whole surface (surface_voxels)
   double skin_to_target_mm = 0.0;     // along the path to the target's surface
   double wall_mm = 0.0;               // skin to gas entry
   double elevation_deg = 0.0;
@@ -86,15 +90,16 @@ struct PortCandidate {
 
 struct PortRanking {
   Vec3 target_centroid_mm = Vec3::Zero();
-  Vec3 target_aim_mm = Vec3::Zero();   // the target voxel nearest the centroid: where paths aim
+  Vec3 target_aim_mm = Vec3::Zero();   // the centroid, or the target voxel nearest it when it lies outside
   int64_t target_voxels = 0;
-  int64_t exposed_voxels = 0;          // target voxels touching the gas: what an instrument can reach
-  std::vector<int> wall_layer_labels;   // labels most trocars cross (skin, fat, muscle): not obstacles
+  int64_t surface_voxels = 0;          // target voxels on its boundary
+  int64_t exposed_voxels = 0;          // those touching the gas: all a scope can see, an instrument reach
+  std::vector<int> wall_layer_labels;   // labels most trocars cross before the gas (skin, fat, muscle)
   std::vector<PortCandidate> candidates;   // best first, the infeasible last
 };
 
 /// The ramps of the terms (0–1), one place for the ranking and the docs' table.
-double visibility_term(double visible_fraction);
+double visibility_term(double share_of_best);   // the visible fraction over the best candidate's
 double clearance_term(double clearance_mm);     // 0 at 0 mm, 1 from 20 mm
 double distance_term(double skin_to_target_mm); // 0 at 60, 1 over 180–240, 0 at 300 mm
 double elevation_term(double elevation_deg);    // 0 at 0°, 1 over 30–60°, 0 at 90°
