@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -49,7 +50,7 @@ Run add_ports(CLI::App& app) {
     ro.cpu_render = o->cpu;
     ro.force = o->force;
     ro.width = o->width;
-    ro.height = o->width * 3 / 4;
+    ro.height = std::max(16, o->width * 3 / 4);
     const OutputFolderLock lock(o->out);
     check_creatable_folder(o->out);
     const PortsRun run = run_ports(scene, ro);

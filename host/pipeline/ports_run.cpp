@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/units.h"
 #include "image/png.h"
 #include "io/volume_io.h"
 #include "mesh/deformation_file.h"
@@ -24,7 +25,8 @@ namespace fs = std::filesystem;
 namespace {
 
 /// The case inflated: a finished simulation in `dir` warped again (seconds), or solved here.
-WarpedCase inflated_case(const Scene& scene, const std::string& dir, bool& reused, bool& converged) {
+WarpedCase inflated_case(const Scene& scene, const std::string& dir, std::optional<Volume> labels, bool& reused,
+                         bool& converged) {
   reused = fs::exists(fs::path(dir) / "deformation.bin") && fs::exists(fs::path(dir) / "metrics.json");
   if (reused) {
     log::info("ports: the simulation in " + dir + " reused");
@@ -40,8 +42,6 @@ WarpedCase inflated_case(const Scene& scene, const std::string& dir, bool& reuse
   solved.displacement_m = displacements(sim.mesh, sim.result.x);
   solved.pressure_pa = sim.result.final_pressure_pa;
   solved.converged = sim.result.converged;
-  std::optional<Volume> labels;
-  if (!scene.inputs.labels.empty()) labels = read_volume(scene.inputs.labels);
   return warp_solved(scene, read_volume(scene.require_ct()), std::move(labels), std::move(sim.roles),
                      std::move(sim.mesh), std::move(solved));
 }
@@ -58,9 +58,25 @@ PortsRun run_ports(const Scene& scene, const PortsRunOptions& o) {
     throw InputError(o.out_dir + ": already holds ports.json; use --force to replace it");
   if (!(o.width >= 16 && o.width <= 4096 && o.height >= 16 && o.height <= 4096))
     throw InputError("the heat map must be 16 to 4096 pixels on each side");
+  // The options and the target checked before any solve (minutes at `accurate`).
+  const PortRankOptions& r0 = o.rank;
+  if (r0.target_label < 1 || r0.target_label > 65535) throw InputError("the target label must be 1 to 65535");
+  if (r0.target_label == scene.output.cavity_label)
+    throw InputError("the target label " + std::to_string(r0.target_label) + " is output.cavity_label, the gas's own");
+  if (!(r0.grid_mm >= 2.0 && r0.grid_mm <= 200.0)) throw InputError("the candidates' grid must be 2 to 200 mm");
+  if (!(r0.fov_deg > 0.0 && r0.fov_deg < 180.0)) throw InputError("fov_deg must be above 0 and below 180");
   const std::map<int, std::string> names = scene_label_names(scene);
+  Volume input_labels = read_volume(scene.inputs.labels);
+  {
+    bool present = false;
+    for (int64_t n = 0; n < input_labels.voxel_count() && !present; ++n) present = input_labels.value(n) == r0.target_label;
+    if (!present)
+      throw InputError("label " + std::to_string(r0.target_label) + " holds no voxel in " + scene.inputs.labels +
+                       ": no target to rank ports for");
+  }
 
-  const WarpedCase w = inflated_case(scene, o.out_dir, run.reused_simulation, run.converged);
+  const WarpedCase w = inflated_case(scene, o.out_dir, std::move(input_labels), run.reused_simulation, run.converged);
+  const double ranked_mmhg = w.deformation.pressure_pa / units::kPaPerMmHg;   // the shape's, not the scene's
   const PointMap map = w.point_map();
   PortRankOptions ro = o.rank;
   ro.gas_label = uint16_t(scene.output.cavity_label);
@@ -76,7 +92,7 @@ PortsRun run_ports(const Scene& scene, const PortsRunOptions& o) {
   const double step_mm = 0.5 * w.output_grid.spacing_mm.minCoeff();
   run.table = port_ranking_json(ranking, ro, names, map, step_mm);
   run.table["seconds"] = rank_s;
-  run.table["pressure_mmhg"] = scene.load.pressure_mmhg;
+  run.table["pressure_mmhg"] = ranked_mmhg;
   run.table["converged"] = run.converged;
   run.table["simulation"] = run.reused_simulation ? "reused from " + o.out_dir : "solved for this ranking";
 
@@ -93,9 +109,11 @@ PortsRun run_ports(const Scene& scene, const PortsRunOptions& o) {
     const RenderImage image = renderer.render(c.camera, skin_settings(base, c.camera, volume.geometry));
     char caption[160];
     std::snprintf(caption, sizeof caption, "ports for %s, %.0f mmHg",
-                  run.table["target"]["name"].get<std::string>().c_str(), scene.load.pressure_mmhg);
+                  run.table["target"]["name"].get<std::string>().c_str(), ranked_mmhg);
     heat = port_heat_map(image, c.camera, ranking, caption, placed);
   }
+  // ports.json last: a folder with the map and without it holds an interrupted ranking, which the
+  // next one replaces without --force (as the warp's images without its metrics).
   fs::create_directories(o.out_dir);
   write_png(run.heat_map_path, heat);
   write_text_file_atomic(run.json_path, run.table.dump(2) + "\n");
