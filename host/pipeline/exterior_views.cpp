@@ -70,23 +70,29 @@ RenderSettings skin_settings(const RenderSettings& s, const ViewCamera& camera, 
   return e;
 }
 
-AnnotatedView annotated_view(const RenderImage& im, const ViewCamera& camera, const std::string& caption,
-                             const std::vector<SkinMark>& marks) {
-  AnnotatedView out;
-  out.image = RgbImage(im.width, im.height);
-  out.image.rgb = to_rgb8(im);
+std::vector<std::string> draw_marks(RgbImage& out, const RenderImage& im, const ViewCamera& camera,
+                                    const std::string& caption, const std::vector<SkinMark>& marks) {
+  std::vector<std::string> marked;
   const int scale = im.width >= 400 ? 2 : 1;
   const double r = 4.0 * scale;
   for (const SkinMark& m : marks) {
     const std::optional<Eigen::Vector2d> p = visible_on_view(im, camera, m.point_mm);
     if (!p) continue;
-    draw_ring(out.image, p->x(), p->y(), r - scale, r + scale, Rgb{0, 0, 0});                // a dark rim: readable on any tone
-    draw_ring(out.image, p->x(), p->y(), r - 0.5 * scale, r + 0.5 * scale, kMarkColour);
-    draw_text(out.image, int(p->x() + r + 2 * scale), int(p->y()) - text_height_px(scale) / 2, m.name, kMarkColour,
-              scale);
-    out.marked.push_back(m.name);
+    draw_ring(out, p->x(), p->y(), r - scale, r + scale, Rgb{0, 0, 0});                // a dark rim: readable on any tone
+    draw_ring(out, p->x(), p->y(), r - 0.5 * scale, r + 0.5 * scale, kMarkColour);
+    draw_text(out, int(p->x() + r + 2 * scale), int(p->y()) - text_height_px(scale) / 2, m.name, kMarkColour, scale);
+    marked.push_back(m.name);
   }
-  draw_text(out.image, 4 * scale, 4 * scale, caption, kCaptionColour, scale);
+  draw_text(out, 4 * scale, 4 * scale, caption, kCaptionColour, scale);
+  return marked;
+}
+
+AnnotatedView annotated_view(const RenderImage& im, const ViewCamera& camera, const std::string& caption,
+                             const std::vector<SkinMark>& marks) {
+  AnnotatedView out;
+  out.image = RgbImage(im.width, im.height);
+  out.image.rgb = to_rgb8(im);
+  out.marked = draw_marks(out.image, im, camera, caption, marks);
   return out;
 }
 

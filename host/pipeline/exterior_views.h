@@ -47,6 +47,12 @@ struct AnnotatedView {
   std::vector<std::string> marked;   // the marks drawn (visible from this camera)
 };
 
+/// Draws on `image` (a render's 8-bit copy, or one drawn over) each mark of `marks` visible on the
+/// render `im` (visible_on_view) as a ring with its name, and `caption` at the top-left; returns the
+/// names drawn.
+std::vector<std::string> draw_marks(RgbImage& image, const RenderImage& im, const ViewCamera& camera,
+                                    const std::string& caption, const std::vector<SkinMark>& marks);
+
 /// A rendered view as an 8-bit image: `caption` at the top-left, each visible mark as a ring with
 /// its name. A mark is visible when it projects into the image and lies no deeper than
 /// kMarkDepthToleranceMm behind the first surface along its pixel's ray.

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "image/text.h"
+#include "render/image_out.h"
 
 namespace pneumo {
 
@@ -116,8 +117,8 @@ nlohmann::json port_ranking_json(const PortRanking& r, const PortRankOptions& o,
 
 RgbImage port_heat_map(const RenderImage& exterior, const ViewCamera& camera, const PortRanking& r,
                        const std::string& caption, const std::vector<SkinMark>& placed_ports) {
-  AnnotatedView a = annotated_view(exterior, camera, caption, placed_ports);
-  RgbImage& im = a.image;
+  RgbImage im(exterior.width, exterior.height);
+  im.rgb = to_rgb8(exterior);
   const int scale = im.width >= 400 ? 2 : 1;
   // Worst first, so the best lie on top where discs overlap.
   std::vector<const PortCandidate*> order;
@@ -149,6 +150,7 @@ RgbImage port_heat_map(const RenderImage& exterior, const ViewCamera& camera, co
   draw_text(im, x0, y0 + bar_h + 2 * scale, "0", white, scale);
   draw_text(im, x0 + bar_w - text_width_px("1", scale), y0 + bar_h + 2 * scale, "1", white, scale);
   draw_text(im, x0 + bar_w / 2 - text_width_px("score", scale) / 2, y0 + bar_h + 2 * scale, "score", white, scale);
+  draw_marks(im, exterior, camera, caption, placed_ports);   // the ports placed on top of the discs
   return im;
 }
 
