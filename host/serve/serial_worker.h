@@ -11,6 +11,7 @@
 // there, so the views keep coming while a solve runs, and a superseded task stops by throwing
 // Superseded, which the worker swallows. After a new shape it calls checkpoint_for_views(), which
 // also waits briefly for the views a watching page asks for it.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -105,6 +106,8 @@ class SerialWorker {
 
   /// A short task arriving within this long of the last one means a page is watching.
   static constexpr std::chrono::seconds kWatchedSeconds{5};
+  /// After a view of a new shape, how long checkpoint_for_views waits for the next one.
+  static constexpr std::chrono::milliseconds kFollowing{50};
 
   /// In a long task that just changed what the views show (a new shape): checkpoint(), then, when a
   /// page is watching (a short task came within kWatchedSeconds), waits up to `window` for the views
@@ -112,13 +115,24 @@ class SerialWorker {
   /// next poll and asks at once; without the wait its view would queue behind the solver's next step.
   /// An unwatched task never waits.
   void checkpoint_for_views(uint64_t generation, std::chrono::milliseconds window) {
+    using Clock = std::chrono::steady_clock;
     checkpoint(generation);
     {
-      std::unique_lock<std::mutex> lock(m_);
-      if (std::chrono::steady_clock::now() - last_short_ > kWatchedSeconds) return;
-      cv_.wait_for(lock, window, [&] { return stop_ || !short_.empty() || long_.has_value(); });
+      std::lock_guard<std::mutex> lock(m_);
+      if (Clock::now() - last_short_ > kWatchedSeconds) return;
     }
-    checkpoint(generation);
+    // Until the window ends: the first view, then any that follow it closely (a page asks for the
+    // laparoscope's view and the body's together), until none comes within kFollowing.
+    const auto end = Clock::now() + window;
+    auto until = end;
+    for (;;) {
+      {
+        std::unique_lock<std::mutex> lock(m_);
+        if (!cv_.wait_until(lock, until, [&] { return stop_ || !short_.empty() || long_.has_value(); })) return;
+      }
+      checkpoint(generation);
+      until = std::min(end, Clock::now() + kFollowing);
+    }
   }
 
   /// Stops after the task running: a long one is superseded; short ones waiting are still run.
