@@ -136,6 +136,12 @@ TEST_F(ServeApi, PageViewsPickAndAWarmReinflation) {
   ASSERT_EQ(scope->status, 200) << scope->body;
   ASSERT_TRUE(is_png(scope->body));
   EXPECT_EQ(png_width(scope->body), 160);
+  // The same port as the page sends it, whole (a scene's port as JSON): the same view.
+  const auto as_json = client_->Get(
+      "/api/scope.png?w=160&h=120&port=" +
+      httplib::detail::encode_query_param(R"({"skin_point_mm":[0,110,-20],"target_label":5,"insertion_mm":45,"oblique_deg":30})"));
+  ASSERT_EQ(as_json->status, 200) << as_json->body;
+  EXPECT_EQ(as_json->body, scope->body);
   const auto ext = client_->Get("/api/exterior.png?side=anterior&w=200&h=150&ports=0,110,-20");
   ASSERT_EQ(ext->status, 200) << ext->body;
   EXPECT_EQ(png_width(ext->body), 200);

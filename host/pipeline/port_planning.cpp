@@ -81,6 +81,13 @@ nlohmann::json port_ranking_json(const PortRanking& r, const PortRankOptions& o,
     if (c.feasible()) {
       ++feasible;
       p["aim_deformed_mm"] = vec_json(c.aim_mm);
+      // A path re-aimed at the exposed surface (the one to the centroid was closed): where a port
+      // placed here must aim, on the CT as given (the target's point, which travels with it).
+      p["reaimed"] = (c.aim_mm - r.target_aim_mm).norm() > 1e-9;
+      if (p["reaimed"].get<bool>()) {
+        const MappedPoint aim = map.to_original(c.aim_mm);
+        p["aim_mm"] = aim.carried ? vec_json(aim.point_mm) : nlohmann::json(nullptr);
+      }
       p["visible_fraction"] = c.visible_fraction;
       p["skin_to_target_mm"] = c.skin_to_target_mm;
       p["wall_mm"] = c.wall_mm;

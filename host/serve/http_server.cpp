@@ -74,16 +74,27 @@ Vec3 vec3_of(const nlohmann::json& j, const std::string& what) {
 /// its messages), the dragged aim and the image size.
 ScopeRequest scope_request(const httplib::Request& q) {
   nlohmann::json port = {{"name", "view"}};
-  port["skin_point_mm"] = {number(q, "sx", NAN), number(q, "sy", NAN), number(q, "sz", NAN)};
-  if (!(std::isfinite(port["skin_point_mm"][0].get<double>()) && std::isfinite(port["skin_point_mm"][1].get<double>()) &&
-        std::isfinite(port["skin_point_mm"][2].get<double>())))
-    throw InputError("sx, sy, sz (the port's skin point, mm) are required");
-  if (q.has_param("label")) {
-    port["target_label"] = whole(number(q, "label", 0), "label", 1, 65535);
+  if (q.has_param("port")) {
+    // The whole port as the scene writes it (lens, up, near plane too), as the page keeps it.
+    try {
+      port = nlohmann::json::parse(q.get_param_value("port"));
+    } catch (const nlohmann::json::exception&) {
+      throw InputError("port: not valid JSON");
+    }
+    if (!port.is_object()) throw InputError("port: a JSON object expected");
+    port["name"] = "view";
   } else {
-    const Vec3 t(number(q, "tx", NAN), number(q, "ty", NAN), number(q, "tz", NAN));
-    if (!t.allFinite()) throw InputError("label or tx, ty, tz (the target) are required");
-    port["target_mm"] = {t.x(), t.y(), t.z()};
+    port["skin_point_mm"] = {number(q, "sx", NAN), number(q, "sy", NAN), number(q, "sz", NAN)};
+    if (!(std::isfinite(port["skin_point_mm"][0].get<double>()) &&
+          std::isfinite(port["skin_point_mm"][1].get<double>()) && std::isfinite(port["skin_point_mm"][2].get<double>())))
+      throw InputError("sx, sy, sz (the port's skin point, mm) are required");
+    if (q.has_param("label")) {
+      port["target_label"] = whole(number(q, "label", 0), "label", 1, 65535);
+    } else {
+      const Vec3 t(number(q, "tx", NAN), number(q, "ty", NAN), number(q, "tz", NAN));
+      if (!t.allFinite()) throw InputError("label or tx, ty, tz (the target) are required");
+      port["target_mm"] = {t.x(), t.y(), t.z()};
+    }
   }
   for (const auto& [param, key] : {std::pair{"ins", "insertion_mm"}, {"fov", "fov_deg"}, {"obl", "oblique_deg"},
                                    {"roll", "roll_deg"}})

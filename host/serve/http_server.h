@@ -8,8 +8,9 @@
 //                               state
 //   POST /api/inflate           {"pressure_mmhg", "wall_young_kpa", "preset"}: a re-inflation from the
 //                               last equilibrium; latest wins (202 with its generation)
-//   GET  /api/scope.png         the laparoscope at a port: sx,sy,sz (skin point, CT as given, mm),
-//                               label or tx,ty,tz (target), ins, fov, obl, roll, yaw, pitch, w, h
+//   GET  /api/scope.png         the laparoscope at a port: port={...} (a scene's port, as JSON) or
+//                               sx,sy,sz (skin point, CT as given, mm) and label or tx,ty,tz (target);
+//                               ins, fov, obl, roll over it; yaw, pitch (the dragged aim), w, h
 //   GET  /api/exterior.png      side=anterior|left, w, h, ports=x,y,z;x,y,z (marked), heat=1 (the last
 //                               port ranking's scores drawn on the skin)
 //   POST /api/ports             {"target_label", "ports": [[x,y,z], ...] (placed, CT as given), "grid_mm",

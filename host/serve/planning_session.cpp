@@ -245,7 +245,8 @@ std::string PlanningSession::scope_png(const ScopeRequest& q) {
   if (!(q.width >= 16 && q.width <= 1920 && q.height >= 16 && q.height <= 1080))
     throw InputError("the view must be 16 to 1920 × 16 to 1080 pixels");
   const Aim a = aim(q);   // the port itself was checked as a scene's (read_port)
-  const ScopePose pose = port_pose(q.port.skin_point_mm, a.skin + a.axis, q.port.insertion_mm, to_deformed(), Vec3(0, 0, 1));
+  const ScopePose pose = port_pose(q.port.skin_point_mm, a.skin + a.axis, q.port.insertion_mm, to_deformed(),
+                                   q.port.optics.up);
   const ViewCamera camera = make_view_camera(pose, q.port.optics, q.width, q.height);
   const RenderImage image = renderer_.render(camera, settings_from_scene(scene_.render, volume_->geometry));
   RgbImage rgb(image.width, image.height);

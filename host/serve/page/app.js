@@ -12,6 +12,11 @@ const OPTICS = { ins: "insertion_mm", fov: "fov_deg", oblique: "oblique_deg", ro
 
 function newPort(name, skin) {
   const p = { name, skin_point_mm: skin, target_label: +$("target").value || null };
+  if (!p.target_label) {   // "the scene's point": the selected port's, else the first that has one
+    const from = state.ports[state.selected] && state.ports[state.selected].target_mm ? state.ports[state.selected]
+               : state.ports.find((q) => q.target_mm);
+    if (from) p.target_mm = from.target_mm.slice();
+  }
   for (const [id, key] of Object.entries(OPTICS)) p[key] = +$(id).value;
   return p;
 }
@@ -48,13 +53,18 @@ async function post(path, body) {
   return j;
 }
 
+// The port as the scene writes it (its lens, up and near plane too), without the page's own keys.
+function portJson(p) {
+  const q = Object.assign({}, p);
+  for (const k of ["name", "yaw_deg", "pitch_deg"]) delete q[k];
+  if (q.target_label) delete q.target_mm; else delete q.target_label;
+  return q;
+}
+
 function scopeUrl() {
-  const p = state.ports[state.selected], s = p.skin_point_mm, size = state.solving ? MOVING_VIEW : VIEW;
-  const q = new URLSearchParams({ sx: s[0], sy: s[1], sz: s[2], ins: p.insertion_mm, fov: p.fov_deg, obl: p.oblique_deg,
-                                  roll: p.roll_deg, yaw: state.yaw, pitch: state.pitch, w: size.w, h: size.h, n: Date.now() });
-  if (p.target_label) q.set("label", p.target_label);
-  else { q.set("tx", p.target_mm[0]); q.set("ty", p.target_mm[1]); q.set("tz", p.target_mm[2]); }
-  return "/api/scope.png?" + q;
+  const p = state.ports[state.selected], size = state.solving ? MOVING_VIEW : VIEW;
+  return "/api/scope.png?" + new URLSearchParams({ port: JSON.stringify(portJson(p)), yaw: state.yaw, pitch: state.pitch,
+                                                   w: size.w, h: size.h, n: Date.now() });
 }
 
 // One view request at a time; a change meanwhile asks again once it is back (latest wins).
@@ -201,7 +211,9 @@ $("rank").addEventListener("click", async () => {
                        `${c.skin_to_target_mm.toFixed(0)} mm to the target`;
       li.onclick = () => {
         const p = newPort("port " + (state.ports.length + 1), c.skin_point_mm);
-        p.target_label = target;
+        // The ranked path: to the organ's centroid, or to the exposed point it was re-aimed at.
+        if (c.reaimed && c.aim_mm) { p.target_label = null; p.target_mm = c.aim_mm; }
+        else { p.target_label = target; delete p.target_mm; }
         state.ports.push(p);
         selectPort(state.ports.length - 1);
         refreshExterior();
@@ -219,12 +231,7 @@ $("plan").addEventListener("click", async () => {
   if (!state.ports.length) { setStatus("place a port on the skin first", true); return; }
   // Each port as the scene writes it (from /api/case, or placed here), its dragged aim beside it:
   // the server reads it as a scene's port and turns the aim into a target point.
-  const ports = state.ports.map((p) => {
-    const q = Object.assign({}, p, { yaw_deg: p.yaw_deg || 0, pitch_deg: p.pitch_deg || 0 });
-    delete q.name;
-    if (q.target_label) delete q.target_mm; else delete q.target_label;
-    return q;
-  });
+  const ports = state.ports.map((p) => Object.assign(portJson(p), { yaw_deg: p.yaw_deg || 0, pitch_deg: p.pitch_deg || 0 }));
   try { await post("/api/plan", { ports }); } catch (e) { setStatus(e.message, true); }
 });
 poll();
