@@ -16,7 +16,7 @@ Run add_ports(CLI::App& app) {
       "ports", "Rank candidate ports on the inflated skin for a target organ; writes ports.json (the ranked table) "
                "and ports_heat_map.png into --out (docs/ports.md)");
   struct Opts {
-    std::string scene, out, device, backend = "auto";
+    std::string scene, out = "out/ports", device, backend = "auto";
     int target = 0, width = 640, height = 480;
     double grid_mm = 20.0, fov_deg = 70.0;
     bool json = false, force = false, cpu = false;
@@ -28,7 +28,7 @@ Run add_ports(CLI::App& app) {
   cmd->add_option("--out", o->out,
                   "Output folder; a finished `pneumo simulate`/`pneumo run` of the scene there is reused, else the "
                   "scene is solved first")
-      ->required();
+      ->capture_default_str();
   cmd->add_option("--grid-mm", o->grid_mm, "Spacing of the candidates on the skin (mm, 2-200)");
   cmd->add_option("--fov-deg", o->fov_deg, "The scope's field of view for the visibility term (degrees)");
   cmd->add_option("--size", o->width, "Width of the heat map (pixels; height 3/4 of it)");
