@@ -44,6 +44,7 @@ class ServeApi : public ::testing::Test {
     o.port = 0;
     o.out_dir = dir_.file("serve_out");
     o.requests_per_second = requests_per_second;
+    o.self_exe = PNEUMO_CLI_PATH;   // a plan runs `pneumo run`; /proc/self/exe here is this test binary
     server_ = std::make_unique<serve::Server>(o);
     port_ = server_->bind();
     listener_ = std::thread([this] { server_->listen(); });
