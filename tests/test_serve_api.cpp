@@ -182,6 +182,19 @@ TEST_F(ServeApi, PageViewsPickAndAWarmReinflation) {
   const auto heat = client_->Get("/api/exterior.png?side=anterior&w=200&h=150&ports=0,110,-20&heat=1");
   ASSERT_EQ(heat->status, 200) << heat->body;
   EXPECT_NE(heat->body, client_->Get("/api/exterior.png?side=anterior&w=200&h=150&ports=0,110,-20")->body);
+  // Within a region painted on that view (its left half): fewer candidates, none from elsewhere;
+  // a region painted on another view than the last drawn is refused.
+  const auto half = client_->Post(
+      "/api/ports",
+      R"({"target_label": 5, "top": 100, "region": {"side": "anterior", "w": 200, "h": 150, "x0": 0, "y0": 0, "x1": 100, "y1": 150}})",
+      "application/json");
+  ASSERT_EQ(half->status, 200) << half->body;
+  const nlohmann::json th = nlohmann::json::parse(half->body);
+  EXPECT_GT(th["candidates_total"].get<int>(), 0);
+  EXPECT_LT(th["candidates_total"].get<int>(), t["candidates_total"].get<int>());
+  EXPECT_EQ(client_->Post("/api/ports",
+                          R"({"target_label": 5, "region": {"side": "left", "w": 200, "h": 150, "x0": 0, "y0": 0, "x1": 9, "y1": 9}})",
+                          "application/json")->status, 409);
   const auto absent = client_->Post("/api/ports", R"({"target_label": 999})", "application/json");
   EXPECT_EQ(absent->status, 400);
   EXPECT_NE(absent->body.find("holds no voxel"), std::string::npos) << absent->body;

@@ -416,7 +416,21 @@ void Server::Impl::routes() {
       if (!b["ports"].is_array() || b["ports"].size() > 16) throw InputError("ports: a list of at most 16 points");
       for (const nlohmann::json& p : b["ports"]) placed.push_back(vec3_of(p, "ports"));
     }
-    answer_json(res, on_worker([&] { return session->rank_ports(target, placed, grid_mm, top); }));
+    std::optional<RankRegion> region;
+    if (b.contains("region") && !b["region"].is_null()) {
+      const nlohmann::json& g = b["region"];
+      if (!g.is_object()) throw InputError("region: an object {side, w, h, x0, y0, x1, y1} expected");
+      RankRegion r;
+      r.side = g.value("side", std::string("anterior"));
+      r.width = whole(g.value("w", 480.0), "region.w", 16, 1920);
+      r.height = whole(g.value("h", 360.0), "region.h", 16, 1080);
+      for (const auto& [key, field] : {std::pair{"x0", &r.x0}, {"y0", &r.y0}, {"x1", &r.x1}, {"y1", &r.y1}}) {
+        if (!g.contains(key) || !g[key].is_number()) throw InputError(std::string("region.") + key + ": a number");
+        *field = g[key].get<double>();
+      }
+      region = r;
+    }
+    answer_json(res, on_worker([&] { return session->rank_ports(target, placed, grid_mm, top, region); }));
   });
   http.Get("/api/slices.png", [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(on_worker([&] { return session->slices_png(); }), "image/png");

@@ -14,8 +14,10 @@
 //   GET  /api/exterior.png      side=anterior|left, w, h, ports=x,y,z;x,y,z (marked), heat=1 (the last
 //                               port ranking's scores drawn on the skin)
 //   POST /api/ports             {"target_label", "ports": [[x,y,z], ...] (placed, CT as given), "grid_mm",
-//                               "top"}: candidate ports ranked on the shape shown (docs/ports.md), the
-//                               best `top` of the table `pneumo ports` writes
+//                               "top", "region": {side, w, h, x0, y0, x1, y1}}: candidate ports ranked on
+//                               the shape shown (docs/ports.md), within the region painted on the last
+//                               body view when given (409 for another view), the best `top` of the
+//                               table `pneumo ports` writes
 //   POST /api/pick              {"x", "y", "side", "w", "h"} on the last exterior view → {"skin_point_mm"}
 //                               (CT as given); 409 when that view is no longer the last drawn
 //   GET  /api/slices.png        axial, coronal, sagittal before and after

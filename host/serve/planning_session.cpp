@@ -285,7 +285,11 @@ std::string PlanningSession::exterior_png(const std::string& side, int width, in
 }
 
 nlohmann::json PlanningSession::rank_ports(int target_label, const std::vector<Vec3>& placed_ports_mm, double grid_mm,
-                                          int top) {
+                                          int top, const std::optional<RankRegion>& region) {
+  if (region && (!last_exterior_ || last_exterior_->side != region->side ||
+                 last_exterior_->camera.width != region->width || last_exterior_->camera.height != region->height))
+    throw StaleView("the region was painted on a body's view that is no longer the last one drawn (" + region->side +
+                    " " + std::to_string(region->width) + "x" + std::to_string(region->height) + "); paint it again");
   PortRankOptions o;
   o.target_label = target_label;
   o.gas_label = uint16_t(scene_.output.cavity_label);
@@ -295,6 +299,22 @@ nlohmann::json PlanningSession::rank_ports(int target_label, const std::vector<V
   const Geometry& g = volume_->geometry;
   Ranking r;
   r.ranking = pneumo::rank_ports(volume_->labels.data(), volume_->hu.data(), g, o);
+  if (region) {
+    // The candidates the user sees inside the region: projected into it and no deeper than the
+    // marks' tolerance behind the surface that view showed at their pixel.
+    const ViewCamera& c = last_exterior_->camera;
+    const double xa = std::min(region->x0, region->x1), xb = std::max(region->x0, region->x1);
+    const double ya = std::min(region->y0, region->y1), yb = std::max(region->y0, region->y1);
+    const auto inside = [&](const PortCandidate& k) {
+      const std::optional<Eigen::Vector2d> p = c.project(k.skin_mm);
+      if (!p || p->x() < xa || p->x() > xb || p->y() < ya || p->y() > yb) return false;
+      if (p->x() < 0 || p->y() < 0 || p->x() >= c.width || p->y() >= c.height) return false;
+      const float depth = last_exterior_->depth_mm[std::size_t(int(p->y()) * c.width + int(p->x()))];
+      return !std::isfinite(depth) || (k.skin_mm - c.position_mm).norm() <= double(depth) + kMarkDepthToleranceMm;
+    };
+    auto& all = r.ranking.candidates;
+    all.erase(std::remove_if(all.begin(), all.end(), [&](const PortCandidate& k) { return !inside(k); }), all.end());
+  }
   nlohmann::json table = port_ranking_json(r.ranking, o, scene_label_names(scene_), *point_map_,
                                            0.5 * g.spacing_mm.minCoeff());
   for (const nlohmann::json& c : table["candidates"])
@@ -306,6 +326,8 @@ nlohmann::json PlanningSession::rank_ports(int target_label, const std::vector<V
   last_ranking_ = std::move(r);
   table["pressure_mmhg"] = shown_pressure_pa_ / units::kPaPerMmHg;
   table["candidates_total"] = table["candidates"].size();
+  if (region) table["region"] = {{"side", region->side}, {"x0", region->x0}, {"y0", region->y0}, {"x1", region->x1},
+                                 {"y1", region->y1}};
   if (int(table["candidates"].size()) > top) table["candidates"].erase(table["candidates"].begin() + top, table["candidates"].end());
   return table;
 }

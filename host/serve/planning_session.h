@@ -50,6 +50,14 @@ struct ScopeRequest {
   int width = 480, height = 360;
 };
 
+/// A region painted on the last exterior view (pixels, corners in any order): the port ranking keeps
+/// only the candidates seen inside it.
+struct RankRegion {
+  std::string side;
+  int width = 0, height = 0;
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
 class PlanningSession {
  public:
   /// The views follow the solve at most this often, and spend at most a third of the time on it
@@ -91,8 +99,11 @@ class PlanningSession {
 
   /// Candidate ports for `target_label` ranked on the shape shown (plan/port_ranking.h), the ports
   /// already placed given on the CT as given: the table `pneumo ports` writes, its first `top`
-  /// candidates (candidates_total says how many there were). Kept for exterior_png's heat map.
-  nlohmann::json rank_ports(int target_label, const std::vector<Vec3>& placed_ports_mm, double grid_mm, int top);
+  /// candidates (candidates_total says how many there were). With `region`, only the candidates
+  /// that show inside it on the last exterior view (StaleView when that view is another), scored as
+  /// among all. Kept for exterior_png's heat map.
+  nlohmann::json rank_ports(int target_label, const std::vector<Vec3>& placed_ports_mm, double grid_mm, int top,
+                            const std::optional<RankRegion>& region = std::nullopt);
 
   /// The scene as it now stands (the file's text with the changes made), to save as a plan, with
   /// `ports` as its render.ports. A port whose aim was dragged aims at a point on the dragged axis

@@ -3,8 +3,8 @@
 opens the page (the scene's ports listed), waits for the first equilibrium, clicks the skin on the
 body's view to place a port,
 waits for the laparoscope's view, moves the pressure slider down, waits for the view to change and
-the status to report the new pressure, ranks the ports for the target, places one at the best
-candidate, and saves a screenshot.
+the status to report the new pressure, paints a region on the body, ranks the ports for the target
+within it, places one at the best candidate, and saves a screenshot.
 
 Usage: serve_page.py PNEUMO SCENE SCRATCH_DIR [SCREENSHOT]
 Exit 0 when every step held, 1 when one did not (the step is printed), 77 when Chromium or its
@@ -19,6 +19,7 @@ try:
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
     from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.common.keys import Keys
 except ImportError as e:
     print(f"skip: python3-selenium is missing ({e}); scripts/install_deps.sh installs it")
@@ -96,9 +97,16 @@ try:
     wait_for("the laparoscope's view changed with the pressure",
              lambda: driver.execute_script(view_settled, scope, ports_before) and scope.screenshot_as_png != before, 60)
 
-    # Port ranking: the target's candidates scored on the skin, the best listed; a click on the first
-    # places a port there.
+    # Port ranking within a region painted by dragging on the body's view (a drag places no port):
+    # the target's candidates scored on the skin, the best listed; a click on the first places a
+    # port there.
     ports_now = len(driver.find_elements(By.CSS_SELECTOR, "#port-list button"))
+    ActionChains(driver).move_to_element_with_offset(exterior, -200, -150).click_and_hold() \
+        .move_by_offset(400, 280).release().perform()
+    wait_for("the painted region shown", lambda: driver.find_element(By.ID, "region").is_displayed(), 10)
+    time.sleep(0.5)
+    if len(driver.find_elements(By.CSS_SELECTOR, "#port-list button")) != ports_now:
+        fail("a drag on the body paints a region and places no port")
     driver.find_element(By.ID, "rank").click()
     wait_for("the ranked ports listed", lambda: driver.find_elements(By.CSS_SELECTOR, "#ranked li"), 120)
     if not driver.find_element(By.ID, "heat").is_selected():

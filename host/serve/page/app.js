@@ -154,9 +154,41 @@ function showOutputs() {
   $("roll-out").textContent = $("roll").value; $("fov-out").textContent = $("fov").value; $("ins-out").textContent = $("ins").value;
 }
 
+// Natural-pixel coordinates of a mouse event on the body's view.
+function onImage(ev) {
+  const img = $("exterior"), r = img.getBoundingClientRect();
+  return { x: (ev.clientX - r.left) * img.naturalWidth / r.width, y: (ev.clientY - r.top) * img.naturalHeight / r.height,
+           r, img };
+}
+
+// Dragging on the body paints a rectangle to rank the ports within; a click without a drag places
+// a port.
+let paint = null;
+$("exterior").addEventListener("mousedown", (ev) => { paint = { start: onImage(ev), moved: false }; ev.preventDefault(); });
+window.addEventListener("mousemove", (ev) => {
+  if (!paint) return;
+  const p = onImage(ev), a = paint.start;
+  if (Math.hypot(p.x - a.x, p.y - a.y) < 6 && !paint.moved) return;
+  paint.moved = true;
+  const box = $("region"), k = p.r.width / p.img.naturalWidth;
+  Object.assign(box.style, { left: Math.min(a.x, p.x) * k + "px", top: Math.min(a.y, p.y) * k + "px",
+                             width: Math.abs(p.x - a.x) * k + "px", height: Math.abs(p.y - a.y) * k + "px" });
+  box.hidden = false;
+  state.region = { side: $("side").value, w: p.img.naturalWidth, h: p.img.naturalHeight, x0: a.x, y0: a.y, x1: p.x, y1: p.y };
+});
+window.addEventListener("mouseup", (ev) => {
+  if (paint && paint.moved) {
+    $("clear-region").hidden = false;
+    if (ev.target === $("exterior")) state.justPainted = true;   // the click that follows ends the drag
+  }
+  paint = null;
+});
+function clearRegion() { state.region = null; $("region").hidden = true; $("clear-region").hidden = true; }
+$("clear-region").addEventListener("click", clearRegion);
+
 $("exterior").addEventListener("click", async (ev) => {
-  const img = ev.target, r = img.getBoundingClientRect();
-  const x = (ev.clientX - r.left) * img.naturalWidth / r.width, y = (ev.clientY - r.top) * img.naturalHeight / r.height;
+  if (state.justPainted) { state.justPainted = false; return; }   // the end of a drag, not a click
+  const { x, y, img } = onImage(ev);
   try {
     const j = await post("/api/pick", { x, y, side: $("side").value, w: img.naturalWidth, h: img.naturalHeight });
     if (!j.skin_point_mm) { setStatus("no skin under that point", true); return; }
@@ -193,7 +225,7 @@ $("target").addEventListener("change", () => {
   state.ports[state.selected].target_label = +$("target").value;
   refreshScope();
 });
-$("side").addEventListener("change", refreshExterior);
+$("side").addEventListener("change", () => { clearRegion(); refreshExterior(); });
 $("heat").addEventListener("change", refreshExterior);
 // Port ranking (docs/ports.md): the target's candidates on the skin, scored; the best listed, each
 // placed as a port by a click.
@@ -202,7 +234,8 @@ $("rank").addEventListener("click", async () => {
   if (!target) { setStatus("choose an organ as the target first", true); return; }
   $("rank").disabled = true;
   try {
-    const t = await post("/api/ports", { target_label: target, ports: state.ports.map((p) => p.skin_point_mm), top: 5 });
+    const t = await post("/api/ports", { target_label: target, ports: state.ports.map((p) => p.skin_point_mm), top: 5,
+                                         region: state.region || null });
     const list = $("ranked");
     list.textContent = "";
     for (const c of t.candidates.filter((c) => c.feasible && c.skin_point_mm)) {
@@ -220,7 +253,8 @@ $("rank").addEventListener("click", async () => {
       };
       list.appendChild(li);
     }
-    if (!list.children.length) setStatus(`no port reaches ${t.target.name}: every path meets an organ or no gas`, true);
+    if (!list.children.length)
+      setStatus(`no port ${state.region ? "in the region " : ""}reaches ${t.target.name}: every path meets an organ or no gas`, true);
     $("heat").disabled = false;
     $("heat").checked = true;
     refreshExterior();
