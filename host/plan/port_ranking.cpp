@@ -29,15 +29,20 @@ double plateau(double v, double a, double b, double c, double d) {
   return std::min(ramp_up(v, a, b), 1.0 - ramp_up(v, c, d));
 }
 
-/// Voxel lookups along straight lines through the grid.
+/// Voxel lookups along straight lines through the grid: millions per ranking, so the world-to-index
+/// map is inverted once here, not per point (Geometry::to_index inverts it each call).
 struct Grid {
+  Grid(const uint16_t* l, const Geometry& geometry, double step)
+      : labels(l), g(geometry), step_mm(step),
+        to_index((geometry.direction * geometry.spacing_mm.asDiagonal()).inverse()) {}
   const uint16_t* labels;
   const Geometry& g;
   double step_mm;
+  Mat3 to_index;
 
   /// The linear index of the voxel holding `p`, -1 outside the grid.
   int64_t voxel(const Vec3& p) const {
-    const Vec3 ijk = g.to_index(p);
+    const Vec3 ijk = to_index * (p - g.origin_mm);
     const int64_t i = std::llround(ijk.x()), j = std::llround(ijk.y()), k = std::llround(ijk.z());
     if (i < 0 || j < 0 || k < 0 || i >= g.dims[0] || j >= g.dims[1] || k >= g.dims[2]) return -1;
     return g.linear_index(i, j, k);
@@ -47,7 +52,20 @@ struct Grid {
     const int64_t v = voxel(p);
     return v < 0 ? -1 : int(labels[v]);
   }
+  /// The world position of voxel `v`'s centre.
+  Vec3 world_of(int64_t v) const {
+    const int64_t i = v % g.dims[0], j = (v / g.dims[0]) % g.dims[1], k = v / (g.dims[0] * g.dims[1]);
+    return g.to_world(Vec3(double(i), double(j), double(k)));
+  }
 };
+
+/// At most `count` of `voxels`, evenly spread through the list, as world points.
+std::vector<Vec3> evenly_spread(const Grid& grid, const std::vector<int64_t>& voxels, std::size_t count) {
+  std::vector<Vec3> out;
+  count = std::min(count, voxels.size());
+  for (std::size_t s = 0; s < count; ++s) out.push_back(grid.world_of(voxels[s * voxels.size() / count]));
+  return out;
+}
 
 /// What the straight path from the skin point towards the aim point meets.
 struct PathWalk {
@@ -149,7 +167,7 @@ double visible_fraction(const Grid& grid, const Vec3& eye, const Vec3& axis, dou
 /// The labelled voxel nearest `p` within `radius_mm` (0 when none): which structure the clearance names.
 int nearest_labelled(const Grid& grid, const std::vector<uint8_t>& obstacle, const Vec3& p, double radius_mm) {
   const Geometry& g = grid.g;
-  const Vec3 c = g.to_index(p);
+  const Vec3 c = grid.to_index * (p - g.origin_mm);
   int best = 0;
   double best_d2 = std::numeric_limits<double>::infinity();
   std::array<int64_t, 3> lo{}, hi{};
@@ -203,9 +221,11 @@ PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometr
   const int64_t n = g.voxel_count();
   PortRanking r;
 
-  // The target: its voxels, centroid, the voxel nearest the centroid, evenly spread surface samples.
+  // The target: its voxels, centroid and boundary; the boundary voxels touching the gas are what a
+  // scope can see and an instrument reach.
+  const Grid grid(labels, g, 0.5 * g.spacing_mm.minCoeff());
   Vec3 sum = Vec3::Zero();
-  std::vector<int64_t> surface, exposed;   // the target's boundary voxels; those touching the gas
+  std::vector<int64_t> surface, exposed;
   const std::array<int64_t, 3> stride{1, g.dims[0], g.dims[0] * g.dims[1]};
   for (int64_t k = 0; k < g.dims[2]; ++k)
     for (int64_t j = 0; j < g.dims[1]; ++j)
@@ -215,61 +235,37 @@ PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometr
         ++r.target_voxels;
         sum += g.to_world(Vec3(double(i), double(j), double(k)));
         const std::array<int64_t, 3> idx{i, j, k};
-        bool inner = true;
-        for (int a = 0; a < 3 && inner; ++a)
+        bool boundary = false, touches_gas = false;   // over the 6 face neighbours; the grid's edge is boundary
+        for (std::size_t a = 0; a < 3; ++a)
           for (int s : {-1, 1}) {
-            const int64_t q = idx[std::size_t(a)] + s;
-            if (q < 0 || q >= g.dims[std::size_t(a)] || labels[v + s * stride[std::size_t(a)]] != target) {
-              inner = false;
-              break;
-            }
+            const int64_t q = idx[a] + s;
+            const int l = q < 0 || q >= g.dims[a] ? -1 : int(labels[v + s * stride[a]]);
+            boundary |= l != target;
+            touches_gas |= l == gas;
           }
-        if (inner) continue;
-        surface.push_back(v);
-        for (int a = 0; a < 3; ++a)
-          for (int s : {-1, 1}) {
-            const int64_t q = idx[std::size_t(a)] + s;
-            if (q >= 0 && q < g.dims[std::size_t(a)] && labels[v + s * stride[std::size_t(a)]] == gas) {
-              exposed.push_back(v);
-              a = 3;
-              break;
-            }
-          }
+        if (boundary) surface.push_back(v);
+        if (touches_gas) exposed.push_back(v);
       }
   if (r.target_voxels == 0)
     throw InputError("label " + std::to_string(target) + " holds no voxel in the deformed labels: no target to rank ports for");
   r.target_centroid_mm = sum / double(r.target_voxels);
-  const auto world_of = [&](int64_t v) {
-    const int64_t i = v % g.dims[0], j = (v / g.dims[0]) % g.dims[1], k = v / (g.dims[0] * g.dims[1]);
-    return g.to_world(Vec3(double(i), double(j), double(k)));
-  };
-  {
+  // Where paths aim first: the centroid when it lies inside the target, else the boundary voxel
+  // nearest it.
+  r.target_aim_mm = r.target_centroid_mm;
+  if (grid.label_at(r.target_centroid_mm) != target) {
     double best = std::numeric_limits<double>::infinity();
-    for (int64_t v : surface) {   // the nearest surface voxel; the centroid itself when it lies inside
-      const double d = (world_of(v) - r.target_centroid_mm).squaredNorm();
-      if (d < best) best = d, r.target_aim_mm = world_of(v);
-    }
-    const Grid probe{labels, g, 0.0};
-    if (probe.label_at(r.target_centroid_mm) == target) r.target_aim_mm = r.target_centroid_mm;
+    for (int64_t v : surface)
+      if (const double d = (grid.world_of(v) - r.target_centroid_mm).squaredNorm(); d < best)
+        best = d, r.target_aim_mm = grid.world_of(v);
   }
   r.exposed_voxels = int64_t(exposed.size());
   r.surface_voxels = int64_t(surface.size());
   const double exposed_share = surface.empty() ? 0.0 : double(exposed.size()) / double(surface.size());
-  // The points an instrument may aim at when the path to the centroid is closed: the exposed
-  // surface, at most kAimTries voxels of it evenly spread (each candidate tries them nearest its
-  // line to the centroid first).
-  std::vector<Vec3> aims;
-  {
-    const std::size_t count = std::min<std::size_t>(exposed.size(), kAimTries);
-    for (std::size_t s = 0; s < count; ++s) aims.push_back(world_of(exposed[s * exposed.size() / count]));
-  }
-  // What visibility is measured on: the target's surface that faces the gas, the only part any
-  // scope can see (the rest lies against other tissue), at most target_samples voxels evenly spread.
-  std::vector<Vec3> samples;
-  {
-    const std::size_t count = std::min<std::size_t>(exposed.size(), std::size_t(std::max(o.target_samples, 1)));
-    for (std::size_t s = 0; s < count; ++s) samples.push_back(world_of(exposed[s * exposed.size() / count]));
-  }
+  // The points an instrument may aim at when the path to the centroid is closed (each candidate
+  // tries them nearest its line to the centroid first), and the points visibility is measured on:
+  // the gas-facing surface, the only part any scope can see.
+  const std::vector<Vec3> aims = evenly_spread(grid, exposed, kAimTries);
+  const std::vector<Vec3> samples = evenly_spread(grid, exposed, std::size_t(std::max(o.target_samples, 1)));
 
   // The candidates: the anterior skin, one point per grid_mm laterally and cranio-caudally, in
   // front of the target's centroid (beside the body the first solid voxel is the couch beneath).
@@ -293,7 +289,6 @@ PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometr
 
   // Pass 1: the wall's own layers, the labels that most trocars cross on their way to the gas (the
   // straight paths to the centroid that reach it; at least kMinWallVotes of them).
-  const Grid grid{labels, g, 0.5 * g.spacing_mm.minCoeff()};
   std::vector<PathWalk> to_centre(skins.size());
 #pragma omp parallel for schedule(dynamic, 4)
   for (int64_t c = 0; c < int64_t(skins.size()); ++c)
@@ -355,7 +350,7 @@ PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometr
   }
   const std::vector<float> clearance = distance_to_mask_mm(obstacle, g);
 
-  // Pass 2: the terms of every candidate whose path is open.
+  // Pass 3: the terms of every candidate whose path is open.
   const double half_fov = 0.5 * o.fov_deg / kDeg;
   r.candidates.resize(skins.size());
 #pragma omp parallel for schedule(dynamic, 2)
