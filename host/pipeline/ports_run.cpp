@@ -59,27 +59,22 @@ PortsRun run_ports(const Scene& scene, const PortsRunOptions& o) {
   if (!(o.width >= 16 && o.width <= 4096 && o.height >= 16 && o.height <= 4096))
     throw InputError("the heat map must be 16 to 4096 pixels on each side");
   // The options and the target checked before any solve (minutes at `accurate`).
-  const PortRankOptions& r0 = o.rank;
-  if (r0.target_label < 1 || r0.target_label > 65535) throw InputError("the target label must be 1 to 65535");
-  if (r0.target_label == scene.output.cavity_label)
-    throw InputError("the target label " + std::to_string(r0.target_label) + " is output.cavity_label, the gas's own");
-  if (!(r0.grid_mm >= 2.0 && r0.grid_mm <= 200.0)) throw InputError("the candidates' grid must be 2 to 200 mm");
-  if (!(r0.fov_deg > 0.0 && r0.fov_deg < 180.0)) throw InputError("fov_deg must be above 0 and below 180");
+  PortRankOptions ro = o.rank;
+  ro.gas_label = uint16_t(scene.output.cavity_label);
+  check_rank_options(ro);
   const std::map<int, std::string> names = scene_label_names(scene);
   Volume input_labels = read_volume(scene.inputs.labels);
   {
     bool present = false;
-    for (int64_t n = 0; n < input_labels.voxel_count() && !present; ++n) present = input_labels.value(n) == r0.target_label;
+    for (int64_t n = 0; n < input_labels.voxel_count() && !present; ++n) present = input_labels.value(n) == ro.target_label;
     if (!present)
-      throw InputError("label " + std::to_string(r0.target_label) + " holds no voxel in " + scene.inputs.labels +
+      throw InputError("label " + std::to_string(ro.target_label) + " holds no voxel in " + scene.inputs.labels +
                        ": no target to rank ports for");
   }
 
   const WarpedCase w = inflated_case(scene, o.out_dir, std::move(input_labels), run.reused_simulation, run.converged);
   const double ranked_mmhg = w.deformation.pressure_pa / units::kPaPerMmHg;   // the shape's, not the scene's
   const PointMap map = w.point_map();
-  PortRankOptions ro = o.rank;
-  ro.gas_label = uint16_t(scene.output.cavity_label);
   std::vector<SkinMark> placed;
   for (const Port& p : scene.render.ports) {
     const MappedPoint d = map.to_deformed(p.skin_point_mm);

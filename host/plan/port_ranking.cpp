@@ -211,12 +211,16 @@ double elevation_term(double deg) { return plateau(deg, 0.0, 30.0, 60.0, 90.0); 
 double spacing_term(double mm) { return ramp_up(mm, 20.0, 50.0); }
 double manipulation_term(double deg) { return plateau(deg, 15.0, 45.0, 75.0, 105.0); }
 
-PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometry& g, const PortRankOptions& o) {
+void check_rank_options(const PortRankOptions& o) {
   if (o.target_label <= 0 || o.target_label > 65535) throw InputError("the target label must be 1 to 65535");
   if (o.target_label == o.gas_label)
     throw InputError("the target label " + std::to_string(o.target_label) + " is the cavity's own label");
   if (!(o.grid_mm >= 2.0 && o.grid_mm <= 200.0)) throw InputError("the candidates' grid must be 2 to 200 mm");
   if (!(o.fov_deg > 0.0 && o.fov_deg < 180.0)) throw InputError("fov_deg must be above 0 and below 180");
+}
+
+PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometry& g, const PortRankOptions& o) {
+  check_rank_options(o);
   const int target = o.target_label, gas = o.gas_label;
   const int64_t n = g.voxel_count();
   PortRanking r;

@@ -106,6 +106,11 @@ double elevation_term(double elevation_deg);    // 0 at 0°, 1 over 30–60°, 0
 double spacing_term(double spacing_mm);         // 0 at 20 mm, 1 from 50 mm
 double manipulation_term(double angle_deg);     // 0 at 15°, 1 over 45–75°, 0 at 105°
 
+/// InputError for options no ranking takes: a target outside 1–65535 or the gas's own label, a grid
+/// or field of view out of range. rank_ports checks them first; a caller with long work before the
+/// ranking (a solve) checks them before it.
+void check_rank_options(const PortRankOptions& o);
+
 /// Ranks the candidates on deformed labels and CT (i fastest on `g`, world mm RAS). InputError
 /// when the target label holds no voxel, or no skin is found.
 PortRanking rank_ports(const uint16_t* labels, const float* ct_hu, const Geometry& g, const PortRankOptions& o);
