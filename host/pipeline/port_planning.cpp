@@ -42,8 +42,14 @@ std::optional<Vec3> skin_point_on_ct(const PointMap& map, const Vec3& skin_mm, c
   return std::nullopt;
 }
 
+std::vector<std::optional<Vec3>> candidates_on_ct(const PortRanking& r, const PointMap& map, double step_mm) {
+  std::vector<std::optional<Vec3>> out;
+  for (const PortCandidate& c : r.candidates) out.push_back(skin_point_on_ct(map, c.skin_mm, c.aim_mm - c.skin_mm, step_mm));
+  return out;
+}
+
 nlohmann::json port_ranking_json(const PortRanking& r, const PortRankOptions& o, const std::map<int, std::string>& names,
-                                 const PointMap& map, double step_mm) {
+                                 const std::vector<std::optional<Vec3>>& on_ct, const PointMap& map) {
   nlohmann::json j;
   j["target"] = {{"label", o.target_label},
                  {"name", name_of(names, o.target_label)},
@@ -69,11 +75,11 @@ nlohmann::json port_ranking_json(const PortRanking& r, const PortRankOptions& o,
   j["wall_layer_labels"] = layers;
   nlohmann::json list = nlohmann::json::array();
   int rank = 0, feasible = 0;
-  for (const PortCandidate& c : r.candidates) {
+  for (std::size_t k = 0; k < r.candidates.size(); ++k) {
+    const PortCandidate& c = r.candidates[k];
     nlohmann::json p;
     p["rank"] = c.feasible() ? nlohmann::json(++rank) : nlohmann::json(nullptr);
-    const std::optional<Vec3> on_ct = skin_point_on_ct(map, c.skin_mm, c.aim_mm - c.skin_mm, step_mm);
-    p["skin_point_mm"] = on_ct ? vec_json(*on_ct) : nlohmann::json(nullptr);
+    p["skin_point_mm"] = on_ct[k] ? vec_json(*on_ct[k]) : nlohmann::json(nullptr);
     p["skin_point_deformed_mm"] = vec_json(c.skin_mm);
     p["feasible"] = c.feasible();
     p["score"] = c.score;

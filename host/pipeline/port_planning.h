@@ -25,11 +25,16 @@ namespace pneumo {
 /// mesh's own boundary. nullopt when none is carried.
 std::optional<Vec3> skin_point_on_ct(const PointMap& map, const Vec3& skin_mm, const Vec3& inward, double step_mm);
 
+/// Each candidate's skin point on the CT as given (skin_point_on_ct, inward along its path), in the
+/// ranking's order: where a port placed there is written, and from where it travels with the skin.
+std::vector<std::optional<Vec3>> candidates_on_ct(const PortRanking& r, const PointMap& map, double step_mm);
+
 /// The ranked table: the target (id, name, centroid), the options and weights, and each candidate
-/// (best first) with its skin point on the CT as given and deformed, its score, terms and measures,
-/// or why it cannot serve. `names` names the labels (empty: "label N").
+/// (best first) with its skin point on the CT as given (`on_ct`, from candidates_on_ct) and deformed,
+/// its score, terms and measures, or why it cannot serve. `names` names the labels (empty: "label
+/// N"); `map` carries a re-aimed path's aim back to the CT.
 nlohmann::json port_ranking_json(const PortRanking& r, const PortRankOptions& o, const std::map<int, std::string>& names,
-                                 const PointMap& map, double step_mm);
+                                 const std::vector<std::optional<Vec3>>& on_ct, const PointMap& map);
 
 /// The exterior view (a render of the skin, with `camera`) with every candidate drawn as a disc in
 /// the colour of its score (small grey dots: infeasible), the best three ringed and numbered, the

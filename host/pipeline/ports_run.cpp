@@ -85,7 +85,7 @@ PortsRun run_ports(const Scene& scene, const PortsRunOptions& o) {
   const PortRanking ranking = rank_ports(w.result.labels.data(), w.result.ct_hu.data(), w.output_grid, ro);
   const double rank_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double step_mm = 0.5 * w.output_grid.spacing_mm.minCoeff();
-  run.table = port_ranking_json(ranking, ro, names, map, step_mm);
+  run.table = port_ranking_json(ranking, ro, names, candidates_on_ct(ranking, map, step_mm), map);
   run.table["seconds"] = rank_s;
   run.table["pressure_mmhg"] = ranked_mmhg;
   run.table["converged"] = run.converged;

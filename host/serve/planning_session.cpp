@@ -315,13 +315,8 @@ nlohmann::json PlanningSession::rank_ports(int target_label, const std::vector<V
     auto& all = r.ranking.candidates;
     all.erase(std::remove_if(all.begin(), all.end(), [&](const PortCandidate& k) { return !inside(k); }), all.end());
   }
-  nlohmann::json table = port_ranking_json(r.ranking, o, scene_label_names(scene_), *point_map_,
-                                           0.5 * g.spacing_mm.minCoeff());
-  for (const nlohmann::json& c : table["candidates"])
-    r.on_ct.push_back(c["skin_point_mm"].is_array() ? std::optional<Vec3>(Vec3(c["skin_point_mm"][0].get<double>(),
-                                                                               c["skin_point_mm"][1].get<double>(),
-                                                                               c["skin_point_mm"][2].get<double>()))
-                                                    : std::nullopt);
+  r.on_ct = candidates_on_ct(r.ranking, *point_map_, 0.5 * g.spacing_mm.minCoeff());
+  nlohmann::json table = port_ranking_json(r.ranking, o, scene_label_names(scene_), r.on_ct, *point_map_);
   r.target_name = table["target"]["name"].get<std::string>();
   last_ranking_ = std::move(r);
   table["pressure_mmhg"] = shown_pressure_pa_ / units::kPaPerMmHg;
