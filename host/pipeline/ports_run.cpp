@@ -92,9 +92,7 @@ PortsRun run_ports(const Scene& scene, const PortsRunOptions& o) {
   run.table["simulation"] = run.reused_simulation ? "reused from " + o.out_dir : "solved for this ranking";
 
   // The heat map on the anterior exterior view of the inflated body.
-  const Volume ct = deformed_ct_volume(w);
-  const Volume labels = deformed_label_volume(w, scene.output.cavity_label);
-  const RenderVolume volume = RenderVolume::from(ct, &labels);
+  const RenderVolume volume = render_volume_of(w.result, w.output_grid);
   Renderer renderer(o.cpu_render, o.backend);
   renderer.set_volume(volume);
   const RenderSettings base = settings_from_scene(scene.render, volume.geometry);

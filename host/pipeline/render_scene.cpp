@@ -55,6 +55,16 @@ constexpr int kStripJpegQuality = 85;
 
 }  // namespace
 
+RenderVolume render_volume_of(const WarpResult& w, const Geometry& g) {
+  RenderVolume v;
+  v.geometry = g;
+  v.hu.resize(w.ct_hu.size());
+  for (std::size_t n = 0; n < w.ct_hu.size(); ++n) v.hu[n] = std::nearbyint(std::clamp(w.ct_hu[n], -32767.0f, 32767.0f));
+  v.hu_is_int16 = true;
+  v.labels = w.labels;
+  return v;
+}
+
 RenderSettings settings_from_scene(const ViewSettings& r, const Geometry& g) {
   RenderSettings s;
   s.tf = scene_transfer_function(r);

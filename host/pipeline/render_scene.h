@@ -22,6 +22,8 @@
 #include "render/gl_context.h"
 #include "render/poses.h"
 #include "render/render_settings.h"
+#include "render/render_volume.h"
+#include "warp/warp.h"
 #include "scene/scene.h"
 
 namespace pneumo {
@@ -57,6 +59,12 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& options, const
 /// The ray caster's settings from a scene's render section, for a volume on grid `g` (the step is
 /// render.step_fraction of its smallest spacing).
 RenderSettings settings_from_scene(const ViewSettings& r, const Geometry& g);
+
+/// The renderer's volume straight from a warp's result on its output grid `g`: HU rounded to whole
+/// numbers, as `pneumo run` stores an int16 CT's deformed_ct.nii.gz (warp_stage.h), so the renderer
+/// packs HU and gradient into one 16-bit texture as it does there. Half a HU is below any transfer
+/// function's resolution. No intermediate Volume: the result is copied once.
+RenderVolume render_volume_of(const WarpResult& w, const Geometry& g);
 
 /// Whether ffmpeg is on PATH, and frames frame_0001.png … in `frame_dir` → `mp4` (H.264 at `fps`
 /// frames/s, written beside and renamed; false with a warning when ffmpeg fails).

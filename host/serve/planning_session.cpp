@@ -199,16 +199,9 @@ void PlanningSession::refresh_shape(const Simulation& sim, const Scene& scene, c
   const double s_map = seconds_since(t0);
   const WarpResult& w = warps_.warp(scene.device, *warp_mesh, src, WarpBox{{0, 0, 0}, g.dims}, wo);
   const double s_warp = seconds_since(t0) - s_map;
-  // The views' volume straight from the warp, HU rounded to whole numbers: as `pneumo run` stores
-  // an int16 CT's deformed_ct.nii.gz (warp_stage.h), so the renderer packs HU and gradient into one
-  // 16-bit texture as it does there, and nothing else holds a copy (the slices and the port ranking
-  // read this one). Half a HU is below any transfer function's resolution.
-  auto volume = std::make_unique<RenderVolume>();
-  volume->geometry = g;
-  volume->hu.resize(w.ct_hu.size());
-  for (std::size_t n = 0; n < w.ct_hu.size(); ++n) volume->hu[n] = std::nearbyint(std::clamp(w.ct_hu[n], -32767.0f, 32767.0f));
-  volume->hu_is_int16 = true;
-  volume->labels = w.labels;
+  // The views' volume straight from the warp; nothing else holds a copy (the slices and the port
+  // ranking read this one).
+  auto volume = std::make_unique<RenderVolume>(render_volume_of(w, g));
   const double s_volume = seconds_since(t0) - s_map - s_warp;
   renderer_.set_volume(*volume);
   log::debug("serve: shape refreshed: point map " + std::to_string(s_map) + " s, warp " + std::to_string(s_warp) +
