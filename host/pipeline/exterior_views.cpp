@@ -36,14 +36,18 @@ void draw_ring(RgbImage& im, double cx, double cy, double r_in, double r_out, Rg
     }
 }
 
-std::optional<Eigen::Vector2d> visible_on_view(const RenderImage& im, const ViewCamera& camera, const Vec3& point_mm) {
+std::optional<Eigen::Vector2d> visible_on_view(const std::vector<float>& depth_mm, const ViewCamera& camera,
+                                               const Vec3& point_mm) {
   const std::optional<Eigen::Vector2d> p = camera.project(point_mm);
-  if (!p || p->x() < 0 || p->y() < 0 || p->x() >= im.width || p->y() >= im.height) return std::nullopt;
-  const std::size_t pixel = std::size_t(int(p->y())) * im.width + std::size_t(int(p->x()));
-  const double surface = im.depth_mm[pixel];
+  if (!p || p->x() < 0 || p->y() < 0 || p->x() >= camera.width || p->y() >= camera.height) return std::nullopt;
+  const double surface = depth_mm[std::size_t(int(p->y())) * std::size_t(camera.width) + std::size_t(int(p->x()))];
   const double along = (point_mm - camera.position_mm).norm();
   if (std::isfinite(surface) && along > surface + kMarkDepthToleranceMm) return std::nullopt;   // behind the body
   return p;
+}
+
+std::optional<Eigen::Vector2d> visible_on_view(const RenderImage& im, const ViewCamera& camera, const Vec3& point_mm) {
+  return visible_on_view(im.depth_mm, camera, point_mm);
 }
 
 std::vector<ExteriorCamera> exterior_cameras(const Geometry& g, int width, int height) {
@@ -59,6 +63,12 @@ std::vector<ExteriorCamera> exterior_cameras(const Geometry& g, int width, int h
     cams.push_back({name, make_view_camera(look_at_pose(f.centre + dist * side, f.centre, Vec3(0, 0, 1)), o, width,
                                            height)});
   return cams;
+}
+
+std::optional<ExteriorCamera> exterior_camera(const Geometry& g, const std::string& side, int width, int height) {
+  for (ExteriorCamera& c : exterior_cameras(g, width, height))
+    if (c.name == "exterior_" + side) return c;
+  return std::nullopt;
 }
 
 RenderSettings skin_settings(const RenderSettings& s, const ViewCamera& camera, const Geometry& g) {

@@ -21,6 +21,8 @@ struct ExteriorCamera {
 /// The anterior and left cameras around grid `g`: a 40° pinhole at the distance where the grid's
 /// bounding sphere fills the width, image up along +z (superior).
 std::vector<ExteriorCamera> exterior_cameras(const Geometry& g, int width, int height);
+/// The one of them named "exterior_<side>" (side "anterior" or "left"); nullopt for another side.
+std::optional<ExteriorCamera> exterior_camera(const Geometry& g, const std::string& side, int width, int height);
 
 /// `s` with the skin transfer function and no label colours; the headlight's falloff distance set
 /// to the camera's distance from the grid's centre, so the body is lit as the cavity is from inside.
@@ -38,6 +40,9 @@ inline constexpr double kMarkDepthToleranceMm = 20.0;
 /// Where `point_mm` shows on a rendered view: its pixel when it projects into the image and lies no
 /// deeper than kMarkDepthToleranceMm behind the first surface along that pixel's ray; nullopt else.
 std::optional<Eigen::Vector2d> visible_on_view(const RenderImage& image, const ViewCamera& camera, const Vec3& point_mm);
+/// The same on a view's depth (camera.width × camera.height, mm to the first surface per pixel).
+std::optional<Eigen::Vector2d> visible_on_view(const std::vector<float>& depth_mm, const ViewCamera& camera,
+                                               const Vec3& point_mm);
 
 /// Pixels whose centres lie between r_in and r_out of (cx, cy), set to `c` (r_in < 0: a disc).
 void draw_ring(RgbImage& image, double cx, double cy, double r_in, double r_out, Rgb c);

@@ -96,15 +96,12 @@ PortsRun run_ports(const Scene& scene, const PortsRunOptions& o) {
   Renderer renderer(o.cpu_render, o.backend);
   renderer.set_volume(volume);
   const RenderSettings base = settings_from_scene(scene.render, volume.geometry);
-  RgbImage heat;
-  for (const ExteriorCamera& c : exterior_cameras(volume.geometry, o.width, o.height)) {
-    if (c.name != "exterior_anterior") continue;
-    const RenderImage image = renderer.render(c.camera, skin_settings(base, c.camera, volume.geometry));
-    char caption[160];
-    std::snprintf(caption, sizeof caption, "ports for %s, %.0f mmHg",
-                  run.table["target"]["name"].get<std::string>().c_str(), ranked_mmhg);
-    heat = port_heat_map(image, c.camera, ranking, caption, placed);
-  }
+  const ExteriorCamera c = *exterior_camera(volume.geometry, "anterior", o.width, o.height);
+  const RenderImage image = renderer.render(c.camera, skin_settings(base, c.camera, volume.geometry));
+  char caption[160];
+  std::snprintf(caption, sizeof caption, "ports for %s, %.0f mmHg", run.table["target"]["name"].get<std::string>().c_str(),
+                ranked_mmhg);
+  const RgbImage heat = port_heat_map(image, c.camera, ranking, caption, placed);
   // ports.json last: a folder with the map and without it holds an interrupted ranking, which the
   // next one replaces without --force (as the warp's images without its metrics).
   fs::create_directories(o.out_dir);

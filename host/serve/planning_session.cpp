@@ -217,6 +217,13 @@ void PlanningSession::refresh_shape(const Simulation& sim, const Scene& scene, c
   status_["cavity_voxels"] = gas;
 }
 
+void PlanningSession::exterior_shown(const std::string& side, int width, int height, const std::string& what) const {
+  if (!last_exterior_) throw InputError(what + " no body's view: ask for one first");
+  if (last_exterior_->side != side || last_exterior_->camera.width != width || last_exterior_->camera.height != height)
+    throw StaleView(what + " a body's view that is no longer the last one drawn (" + side + " " + std::to_string(width) +
+                    "x" + std::to_string(height) + "); ask for it again");
+}
+
 PointMapFn PlanningSession::to_deformed() const { return deformed_point_fn(*point_map_, false); }
 
 PlanningSession::Aim PlanningSession::aim(const ScopeRequest& q) const {
@@ -251,38 +258,33 @@ std::string PlanningSession::exterior_png(const std::string& side, int width, in
                                           const std::vector<Vec3>& ports_mm, bool heat) {
   if (!(width >= 16 && width <= 1920 && height >= 16 && height <= 1080))
     throw InputError("the view must be 16 to 1920 × 16 to 1080 pixels");
-  const std::string name = "exterior_" + side;
-  for (const ExteriorCamera& c : exterior_cameras(volume_->geometry, width, height)) {
-    if (c.name != name) continue;
-    const RenderSettings s = skin_settings(settings_from_scene(scene_.render, volume_->geometry), c.camera,
-                                           volume_->geometry);
-    const RenderImage image = renderer_.render(c.camera, s);
-    const PointMapFn map = to_deformed();
-    std::vector<SkinMark> marks;
-    for (std::size_t k = 0; k < ports_mm.size(); ++k) marks.push_back({"port " + std::to_string(k + 1), map(ports_mm[k])});
-    char caption[160];
-    std::snprintf(caption, sizeof caption, "%.1f mmHg", shown_pressure_pa_ / units::kPaPerMmHg);
-    last_exterior_ = Exterior{side, c.camera, image.depth_mm, warp_mesh_, point_map_};
-    if (heat && last_ranking_) {
-      // The candidates where the shape shown has carried them (the ranking may be of an earlier one).
-      PortRanking shown = last_ranking_->ranking;
-      for (std::size_t k = 0; k < shown.candidates.size(); ++k)
-        if (last_ranking_->on_ct[k]) shown.candidates[k].skin_mm = map(*last_ranking_->on_ct[k]);
-      std::snprintf(caption, sizeof caption, "%.1f mmHg, ports for %s", shown_pressure_pa_ / units::kPaPerMmHg,
-                    last_ranking_->target_name.c_str());
-      return encode_png(port_heat_map(image, c.camera, shown, caption, marks));
-    }
-    return encode_png(annotated_view(image, c.camera, caption, marks).image);
+  const std::optional<ExteriorCamera> found = exterior_camera(volume_->geometry, side, width, height);
+  if (!found) throw InputError("side must be anterior or left");
+  const ExteriorCamera& c = *found;
+  const RenderSettings s = skin_settings(settings_from_scene(scene_.render, volume_->geometry), c.camera,
+                                         volume_->geometry);
+  const RenderImage image = renderer_.render(c.camera, s);
+  const PointMapFn map = to_deformed();
+  std::vector<SkinMark> marks;
+  for (std::size_t k = 0; k < ports_mm.size(); ++k) marks.push_back({"port " + std::to_string(k + 1), map(ports_mm[k])});
+  char caption[160];
+  std::snprintf(caption, sizeof caption, "%.1f mmHg", shown_pressure_pa_ / units::kPaPerMmHg);
+  last_exterior_ = Exterior{side, c.camera, image.depth_mm, warp_mesh_, point_map_};
+  if (heat && last_ranking_) {
+    // The candidates where the shape shown has carried them (the ranking may be of an earlier one).
+    PortRanking shown = last_ranking_->ranking;
+    for (std::size_t k = 0; k < shown.candidates.size(); ++k)
+      if (last_ranking_->on_ct[k]) shown.candidates[k].skin_mm = map(*last_ranking_->on_ct[k]);
+    std::snprintf(caption, sizeof caption, "%.1f mmHg, ports for %s", shown_pressure_pa_ / units::kPaPerMmHg,
+                  last_ranking_->target_name.c_str());
+    return encode_png(port_heat_map(image, c.camera, shown, caption, marks));
   }
-  throw InputError("side must be anterior or left");
+  return encode_png(annotated_view(image, c.camera, caption, marks).image);
 }
 
 nlohmann::json PlanningSession::rank_ports(int target_label, const std::vector<Vec3>& placed_ports_mm, double grid_mm,
                                           int top, const std::optional<RankRegion>& region) {
-  if (region && (!last_exterior_ || last_exterior_->side != region->side ||
-                 last_exterior_->camera.width != region->width || last_exterior_->camera.height != region->height))
-    throw StaleView("the region was painted on a body's view that is no longer the last one drawn (" + region->side +
-                    " " + std::to_string(region->width) + "x" + std::to_string(region->height) + "); paint it again");
+  if (region) exterior_shown(region->side, region->width, region->height, "the region was painted on");
   PortRankOptions o;
   o.target_label = target_label;
   o.gas_label = uint16_t(scene_.output.cavity_label);
@@ -293,17 +295,13 @@ nlohmann::json PlanningSession::rank_ports(int target_label, const std::vector<V
   Ranking r;
   r.ranking = pneumo::rank_ports(volume_->labels.data(), volume_->hu.data(), g, o);
   if (region) {
-    // The candidates the user sees inside the region: projected into it and no deeper than the
-    // marks' tolerance behind the surface that view showed at their pixel.
-    const ViewCamera& c = last_exterior_->camera;
+    // The candidates the user sees inside the region on that view.
+    const Exterior& view = *last_exterior_;
     const double xa = std::min(region->x0, region->x1), xb = std::max(region->x0, region->x1);
     const double ya = std::min(region->y0, region->y1), yb = std::max(region->y0, region->y1);
     const auto inside = [&](const PortCandidate& k) {
-      const std::optional<Eigen::Vector2d> p = c.project(k.skin_mm);
-      if (!p || p->x() < xa || p->x() > xb || p->y() < ya || p->y() > yb) return false;
-      if (p->x() < 0 || p->y() < 0 || p->x() >= c.width || p->y() >= c.height) return false;
-      const float depth = last_exterior_->depth_mm[std::size_t(int(p->y()) * c.width + int(p->x()))];
-      return !std::isfinite(depth) || (k.skin_mm - c.position_mm).norm() <= double(depth) + kMarkDepthToleranceMm;
+      const std::optional<Eigen::Vector2d> p = visible_on_view(view.depth_mm, view.camera, k.skin_mm);
+      return p && p->x() >= xa && p->x() <= xb && p->y() >= ya && p->y() <= yb;
     };
     auto& all = r.ranking.candidates;
     all.erase(std::remove_if(all.begin(), all.end(), [&](const PortCandidate& k) { return !inside(k); }), all.end());
@@ -321,10 +319,7 @@ nlohmann::json PlanningSession::rank_ports(int target_label, const std::vector<V
 }
 
 std::optional<Vec3> PlanningSession::pick(const std::string& side, int width, int height, double x_px, double y_px) {
-  if (!last_exterior_) throw InputError("no exterior view to pick on: ask for one first");
-  if (last_exterior_->side != side || last_exterior_->camera.width != width || last_exterior_->camera.height != height)
-    throw StaleView("the body's view clicked on is no longer the last one drawn (" + side + " " + std::to_string(width) +
-                    "x" + std::to_string(height) + "); ask for it again");
+  exterior_shown(side, width, height, "the click was on");
   const ViewCamera& c = last_exterior_->camera;
   if (!(x_px >= 0 && y_px >= 0 && x_px < c.width && y_px < c.height)) return std::nullopt;
   const float depth = last_exterior_->depth_mm[std::size_t(int(y_px) * c.width + int(x_px))];

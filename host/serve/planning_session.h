@@ -125,6 +125,9 @@ class PlanningSession {
   nlohmann::json scene_ports() const;   // the scene's ports, for the page to start from
   nlohmann::json label_list() const;    // the label map's ids with their names, for the targets
   PointMapFn to_deformed() const;
+  /// Throws unless the last exterior view drawn is the one from `side` at width × height: InputError
+  /// when there is none, StaleView (409) when it is another. `what` begins the message.
+  void exterior_shown(const std::string& side, int width, int height, const std::string& what) const;
   /// The scope's axis in the deformed frame: from the port's skin point to its target, turned by
   /// the dragged yaw (about the superior axis) and pitch (about the axis's right). InputError for an
   /// unknown label or a target on the skin point.
