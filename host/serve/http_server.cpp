@@ -84,10 +84,9 @@ ScopeRequest scope_request(const httplib::Request& q) {
     if (!port.is_object()) throw InputError("port: a JSON object expected");
     port["name"] = "view";
   } else {
-    port["skin_point_mm"] = {number(q, "sx", NAN), number(q, "sy", NAN), number(q, "sz", NAN)};
-    if (!(std::isfinite(port["skin_point_mm"][0].get<double>()) &&
-          std::isfinite(port["skin_point_mm"][1].get<double>()) && std::isfinite(port["skin_point_mm"][2].get<double>())))
-      throw InputError("sx, sy, sz (the port's skin point, mm) are required");
+    const Vec3 skin(number(q, "sx", NAN), number(q, "sy", NAN), number(q, "sz", NAN));
+    if (!skin.allFinite()) throw InputError("sx, sy, sz (the port's skin point, mm) are required");
+    port["skin_point_mm"] = {skin.x(), skin.y(), skin.z()};
     if (q.has_param("label")) {
       port["target_label"] = whole(number(q, "label", 0), "label", 1, 65535);
     } else {
