@@ -41,6 +41,41 @@ WarpMesh make_warp_mesh(const Mesh& mesh, const std::vector<Vec3>& displacement_
   return w;
 }
 
+WarpMesh warp_mesh_on_grid(const WarpMesh& m, const Geometry& target) {
+  WarpMesh w;
+  w.grid = target;
+  const Mat3 a_src = m.grid.direction * m.grid.spacing_mm.asDiagonal();
+  const Mat3 a_tgt_inv = (target.direction * target.spacing_mm.asDiagonal()).inverse();
+  const Mat3 lin = a_tgt_inv * a_src;   // source index units → target index units
+  w.rest_ijk.resize(m.rest_ijk.size());
+  w.disp_ijk.resize(m.disp_ijk.size());
+  for (std::size_t n = 0; n < m.rest_ijk.size(); ++n) {
+    w.rest_ijk[n] = target.to_index(m.grid.to_world(m.rest_ijk[n]));
+    w.disp_ijk[n] = lin * m.disp_ijk[n];
+  }
+  w.tets = m.tets;
+  w.tet_part = m.tet_part;
+  w.cube_voxels = 1;
+  w.cubes = {target.dims[0], target.dims[1], target.dims[2]};
+  w.cube_meshed.assign(std::size_t(target.voxel_count()), 0);
+  const Mat3 to_src = a_src.inverse() * (target.direction * target.spacing_mm.asDiagonal());
+  const Vec3 src0 = m.grid.to_index(target.origin_mm);
+  const double L = m.cube_voxels;
+  for (int64_t k = 0; k < target.dims[2]; ++k)
+    for (int64_t j = 0; j < target.dims[1]; ++j)
+      for (int64_t i = 0; i < target.dims[0]; ++i) {
+        const Vec3 s = src0 + to_src * Vec3(double(i), double(j), double(k));
+        // Cube a spans [aL − ½, (a+1)L − ½) in the source's index coordinates.
+        const double a = std::floor((s.x() + 0.5) / L), b = std::floor((s.y() + 0.5) / L),
+                     c = std::floor((s.z() + 0.5) / L);
+        if (a < 0 || b < 0 || c < 0 || a >= double(m.cubes[0]) || b >= double(m.cubes[1]) || c >= double(m.cubes[2]))
+          continue;
+        w.cube_meshed[std::size_t(i + target.dims[0] * (j + target.dims[1] * k))] =
+            m.cube_meshed[std::size_t(int64_t(a) + m.cubes[0] * (int64_t(b) + m.cubes[1] * int64_t(c)))];
+      }
+  return w;
+}
+
 void check_warp_mesh(const WarpMesh& m) {
   auto fail = [](const std::string& what) { throw std::invalid_argument("warp mesh: " + what); };
   const int64_t nodes = int64_t(m.rest_ijk.size());

@@ -62,6 +62,13 @@ PadVoxels growth_to_hold_deformed(const WarpMesh& m, const Index3& max_voxels);
 /// their common voxels. std::invalid_argument unless grow.lo is whole cubes and no end shrinks.
 WarpMesh grown_warp_mesh(const WarpMesh& m, const PadVoxels& grow);
 
+/// The same deformation on another grid: `m`'s nodes and displacements in `target`'s index
+/// coordinates (through world mm), and its rest space as a table of `target`'s single voxels
+/// (cube_voxels 1): a voxel lies in it when its centre lies in a cube `m`'s meshes filled. One solve's
+/// deformation applied to the same body imaged at another resolution (`pneumo validate
+/// view-resolution`); on `m.grid` itself the warp is unchanged.
+WarpMesh warp_mesh_on_grid(const WarpMesh& m, const Geometry& target);
+
 /// A deformed tetrahedron too flat to invert (|det| of its edge matrix below 1e-9 of its edge
 /// length cubed): it covers no voxel centre in a way that could be sampled. Both the reference and
 /// the device skip exactly the tetrahedra this names, so they never disagree about them.
