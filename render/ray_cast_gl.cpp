@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <array>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -45,7 +46,9 @@ struct GlRayCaster::Impl {
   GlContext& ctx;
   std::map<std::string, std::unique_ptr<gl::ShaderProgram>> programs;  // by variant (#defines)
   GLuint vao = 0, fbo = 0, colour_tex = 0, depth_tex = 0;
-  GLuint hu_tex = 0, grad_tex = 0, label_tex = 0, occ_tex = 0, tf_tex = 0, label_rgba_tex = 0;
+  GLuint hu_tex = 0, grad_tex = 0, label_tex = 0, occ_tex = 0, tf_tex = 0, label_colour_tex = 0;
+  const RenderVolume* volume = nullptr;                    // set_volume's: it outlives the renders
+  std::optional<std::vector<std::array<uint8_t, 4>>> colours_uploaded;   // none: no colour volume yet
   bool packed = false;  // hu_tex holds (HU, gradient); grad_tex unused
   int fb_width = 0, fb_height = 0;
   bool have_volume = false;
@@ -66,7 +69,7 @@ struct GlRayCaster::Impl {
 
   ~Impl() {
     const gl::Api& g = gl::api();
-    GLuint tex[] = {colour_tex, depth_tex, hu_tex, grad_tex, label_tex, occ_tex, tf_tex, label_rgba_tex};
+    GLuint tex[] = {colour_tex, depth_tex, hu_tex, grad_tex, label_tex, occ_tex, tf_tex, label_colour_tex};
     for (GLuint t : tex)
       if (t) g.DeleteTextures(1, &t);
     if (fbo) g.DeleteFramebuffers(1, &fbo);
@@ -107,6 +110,27 @@ struct GlRayCaster::Impl {
     fb_height = h;
   }
 
+  // The organ colours per voxel (label_colour_volume), built when the colours differ from the last
+  // built for this volume: once per volume in practice.
+  void upload_label_colours(const LabelColours& c) {
+    if (colours_uploaded && *colours_uploaded == c.rgba) return;
+    const gl::Api& g = gl::api();
+    if (label_colour_tex) g.DeleteTextures(1, &label_colour_tex);
+    label_colour_tex = make_texture(GL_TEXTURE_3D, GL_LINEAR);
+    g.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    if (volume->labels.empty()) {
+      const uint8_t zero[4] = {0, 0, 0, 0};
+      g.TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8, 1, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, zero);
+    } else {
+      const std::vector<uint8_t> rgba = label_colour_volume(*volume, c);
+      const auto& d = geometry.dims;
+      g.TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RGBA,
+                   GL_UNSIGNED_BYTE, rgba.data());
+    }
+    gl::check_error("label colour upload");
+    colours_uploaded = c.rgba;
+  }
+
   void upload_occupancy(const RenderSettings& s) {
     const OccupancyKey key = occupancy_key(s);
     if (occ_key && *occ_key == key) return;
@@ -144,7 +168,9 @@ void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
   m.hu_tex = make_texture(GL_TEXTURE_3D, GL_LINEAR);
   // SNORM maps s to s/32767 exactly for s in ±32767 and filters in floating point.
   m.packed = v.hu_is_int16 && !force_float;
-  const std::vector<int16_t> grad = voxel_gradients(v, m.packed);
+  std::optional<RenderVolume> smoothed;
+  const RenderVolume& viewed = volume_as_viewed(v, smoothed);
+  const std::vector<int16_t> grad = voxel_gradients(viewed, m.packed);
   if (m.packed) {  // (HU, gx, gy, gz): one fetch per shaded sample
     g.TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA16_SNORM, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RGBA,
                  GL_SHORT, grad.data());
@@ -152,7 +178,7 @@ void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
     m.hu_format = "rgba16_snorm";
   } else {
     g.TexImage3D(GL_TEXTURE_3D, 0, GL_R32F, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RED, GL_FLOAT,
-                 v.hu.data());
+                 viewed.hu.data());
     m.grad_tex = make_texture(GL_TEXTURE_3D, GL_LINEAR);
     g.TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA16_SNORM, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RGBA,
                  GL_SHORT, grad.data());
@@ -172,8 +198,10 @@ void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
   gl::check_error("label upload");
   m.geometry = v.geometry;
   m.w2i = v.world_to_index();
-  m.ranges = block_ranges(v);
+  m.ranges = block_ranges(viewed);
   m.occ_key.reset();
+  m.volume = &v;
+  m.colours_uploaded.reset();
   m.have_volume = true;
   log::debug("GL ray caster: volume " + std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" +
              std::to_string(d[2]) + " as " + m.hu_format);
@@ -213,17 +241,14 @@ RenderImage GlRayCaster::render(const ViewCamera& cam, const RenderSettings& s) 
   for (std::size_t i = 3; i < tf.size(); i += 4)
     tf[i] = float(1.0 - std::pow(1.0 - std::min(double(tf[i]), 1.0), exponent));
   g.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, kTfTableSize, 1, 0, GL_RGBA, GL_FLOAT, tf.data());
-  if (!m.label_rgba_tex) m.label_rgba_tex = make_texture(GL_TEXTURE_2D, GL_NEAREST);
-  g.BindTexture(GL_TEXTURE_2D, m.label_rgba_tex);
-  g.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  g.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 256, 256, 0, GL_RGBA, GL_UNSIGNED_BYTE, s.label_colours.rgba.data());
-  gl::check_error("tables upload");
+  gl::check_error("table upload");
+  if (s.show_labels) m.upload_label_colours(s.label_colours);
 
   const gl::ShaderProgram& prog = m.program(m.packed, s.show_labels, s.hide_exterior_air);
   prog.use();
-  const GLuint textures[] = {m.hu_tex, m.grad_tex, m.label_tex, m.occ_tex, m.tf_tex, m.label_rgba_tex};
-  const GLenum targets[] = {GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_2D, GL_TEXTURE_2D};
-  const char* names[] = {"u_vol", "u_grad", "u_labels", "u_occupancy", "u_tf", "u_label_rgba"};
+  const GLuint textures[] = {m.hu_tex, m.grad_tex, m.label_tex, m.occ_tex, m.tf_tex, s.show_labels ? m.label_colour_tex : 0};
+  const GLenum targets[] = {GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_3D, GL_TEXTURE_2D, GL_TEXTURE_3D};
+  const char* names[] = {"u_vol", "u_grad", "u_labels", "u_occupancy", "u_tf", "u_label_colour"};
   for (int i = 0; i < 6; ++i) {
     if (!textures[i]) continue;
     g.ActiveTexture(GL_TEXTURE0 + i);

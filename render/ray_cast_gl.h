@@ -1,6 +1,6 @@
 #pragma once
 // The GL ray caster: uploads a RenderVolume as 3-D textures (HU as 16-bit or float, labels as
-// 16-bit integers, the occupancy grid), runs shaders/raycast.frag over a full-screen triangle into
+// 16-bit integers, premultiplied organ colours as RGBA8, the occupancy grid), runs shaders/raycast.frag over a full-screen triangle into
 // a framebuffer object (RGBA32F colour + R32F depth) and reads the image back.
 #include <memory>
 #include <string>
@@ -24,7 +24,9 @@ class GlRayCaster {
   /// volume). When the HU are integers within ±32767 and `force_float` is off, HU and gradient
   /// share one RGBA16_SNORM texture (exact: a shaded sample is one fetch); else the HU go into a
   /// 32-bit float texture and the gradient into an RGBA16_SNORM one.
-  /// InputError when a dimension exceeds the driver's GL_MAX_3D_TEXTURE_SIZE.
+  /// InputError when a dimension exceeds the driver's GL_MAX_3D_TEXTURE_SIZE. The volume must outlive
+  /// the renders: the organ colours per voxel are built from its labels at the first render that shows
+  /// them (and again when the colours change).
   void set_volume(const RenderVolume& volume, bool force_float = false);
 
   /// Renders one view (blocks until the image is read back).

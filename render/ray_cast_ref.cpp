@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace pneumo {
 namespace {
@@ -47,6 +48,15 @@ struct Sampler {
            });
   }
 
+  // Trilinear premultiplied label colour (premultiplied_colour(), 0..1 per channel).
+  Eigen::Vector4d label_colour(const Vec3& p, const LabelColours& colours) const {
+    if (v.labels.empty()) return Eigen::Vector4d::Zero();
+    return trilinear<Eigen::Vector4d>(p, [&](int64_t i, int64_t j, int64_t k) {
+             const auto q = premultiplied_colour(colours, v.labels[i + nx * (j + ny * k)]);
+             return Eigen::Vector4d(q[0], q[1], q[2], q[3]);
+           }) / 255.0;
+  }
+
   uint16_t label(const Vec3& p) const {
     if (v.labels.empty()) return 0;
     const int64_t i = std::clamp<int64_t>(int64_t(std::floor(p.x() + 0.5)), 0, nx - 1);
@@ -75,7 +85,9 @@ std::pair<double, double> clip_to_box(const Vec3& o, const Vec3& d, const Index3
 
 }  // namespace
 
-RenderImage render_reference(const RenderVolume& volume, const ViewCamera& cam, const RenderSettings& s) {
+RenderImage render_reference(const RenderVolume& input, const ViewCamera& cam, const RenderSettings& s) {
+  std::optional<RenderVolume> smoothed;   // the views' reconstruction, built per call (the reference is slow anyway)
+  const RenderVolume& volume = volume_as_viewed(input, smoothed);
   RenderImage img;
   img.width = cam.width;
   img.height = cam.height;
@@ -131,15 +143,13 @@ RenderImage render_reference(const RenderVolume& volume, const ViewCamera& cam, 
           }
         }
         t_clear = -1.0;
-        const uint16_t id = smp.label(p);
         const double h = smp.hu(p);
         const double alpha = s.tf.opacity_at(h);
         const double a = 1.0 - std::pow(1.0 - std::min(alpha, 1.0), exponent);
         Vec3 c = s.tf.colour_at(h);
         if (s.show_labels) {
-          const auto& lc = s.label_colours.rgba[id];
-          const double w = s.label_opacity * lc[3] / 255.0;
-          c = (1.0 - w) * c + w * Vec3(lc[0], lc[1], lc[2]) / 255.0;
+          const Eigen::Vector4d lc = smp.label_colour(p, s.label_colours);
+          c = (1.0 - s.label_opacity * lc[3]) * c + s.label_opacity * lc.head<3>();
         }
         const Vec3 g = w2i_t * smp.gradient(p);
         double diffuse = 1.0, specular = 0.0;

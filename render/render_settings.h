@@ -2,6 +2,9 @@
 // The ray-casting model both ray casters implement (the GLSL one in shaders/raycast.frag and the
 // CPU reference in ray_cast_ref.cpp), stated once (method.md §8):
 //
+// 0. Volume: the CT as RenderVolume::smoothing_mm reconstructs it (smooth_for_views in
+//    render_volume.h: a Gaussian prefilter of the views' copy); every HU and gradient below is read
+//    from that copy, labels from the volume itself.
 // 1. Ray: from the camera's tip along ViewCamera::ray() of the pixel centre. It is clipped to the
 //    box of voxel centres (index space [0, dims−1]); samples sit at t_k = near + (k + j)·Δs mm for
 //    the k with t_k inside the clipped interval; j = 0, or with jitter a per-pixel hash in [0, 1)
@@ -18,7 +21,10 @@
 //    Without it the first sample of a surface lies anywhere up to a step inside it, in bands that
 //    follow the step lattice (wood grain). A moved sample that contributes nothing (a layer
 //    thinner than half a step) counts as clear.
-// 3. Labels: the nearest voxel's id picks an RGBA colour; c ← mix(c, label rgb, label_opacity·a).
+// 3. Labels: each voxel's id picks an RGBA colour, stored premultiplied (premultiplied_colour() in
+//    render_volume.h); their trilinear interpolation (R, G, B, A) at the sample gives
+//    c ← c·(1 − label_opacity·A) + label_opacity·(R, G, B): organ edges blend over a voxel instead
+//    of stepping at the nearest voxel's boundary.
 // 4. Shading (Phong with a headlight at the tip): gradient g (HU per voxel index) by trilinear
 //    interpolation, at the sample, of per-voxel central differences pre-computed once per volume
 //    (voxel_gradient() in render_volume.h: (h[i+1] − h[i−1])/2 per index axis, the difference

@@ -59,6 +59,63 @@ void RenderVolume::mark_exterior_air(double threshold_hu) {
   }
 }
 
+Vec3 view_smoothing_sigma_voxels(const Geometry& g, double smoothing_mm) {
+  if (!(smoothing_mm > 0.0)) return Vec3::Zero();
+  Vec3 s;
+  for (int a = 0; a < 3; ++a) s[a] = std::max(1.0, smoothing_mm / g.spacing_mm[a]);
+  return s;
+}
+
+void smooth_for_views(RenderVolume& v, const Vec3& sigma_voxels) {
+  if (!(sigma_voxels.minCoeff() > 0.0) || v.hu.empty()) return;
+  const Index3 d = v.geometry.dims;
+  const int64_t stride[3] = {1, d[0], d[0] * d[1]};
+  std::vector<float> tmp(v.hu.size());
+  // One pass per axis, from v.hu into tmp and back: each line read once into a buffer.
+  for (int a = 0; a < 3; ++a) {
+    const double sigma = sigma_voxels[a];
+    const int radius = std::max(1, int(std::ceil(3.0 * sigma)));
+    std::vector<double> w(std::size_t(2 * radius + 1));
+    double sum = 0.0;
+    for (int r = -radius; r <= radius; ++r) sum += w[std::size_t(r + radius)] = std::exp(-0.5 * r * r / (sigma * sigma));
+    for (double& x : w) x /= sum;
+    const int b = (a + 1) % 3, c = (a + 2) % 3;
+    const int64_t n = d[a];
+    const std::vector<float>& in = a % 2 == 0 ? v.hu : tmp;
+    std::vector<float>& out = a % 2 == 0 ? tmp : v.hu;
+#pragma omp parallel
+    {
+      std::vector<double> line(std::size_t(n + 2 * radius));
+#pragma omp for schedule(static)
+      for (int64_t q = 0; q < d[b] * d[c]; ++q) {
+        const int64_t base = (q % d[b]) * stride[b] + (q / d[b]) * stride[c];
+        for (int64_t t = -radius; t < n + radius; ++t)
+          line[std::size_t(t + radius)] = in[std::size_t(base + std::clamp<int64_t>(t, 0, n - 1) * stride[a])];
+        for (int64_t t = 0; t < n; ++t) {
+          double acc = 0.0;
+          for (int r = 0; r <= 2 * radius; ++r) acc += w[std::size_t(r)] * line[std::size_t(t + r)];
+          out[std::size_t(base + t * stride[a])] = float(acc);
+        }
+      }
+    }
+  }
+  // Three passes end in tmp.
+  v.hu.swap(tmp);
+  if (v.hu_is_int16)
+    for (float& x : v.hu) x = std::nearbyint(std::clamp(x, -32767.0f, 32767.0f));
+}
+
+const RenderVolume& volume_as_viewed(const RenderVolume& v, std::optional<RenderVolume>& storage) {
+  if (!(v.smoothing_mm > 0.0)) return v;
+  storage.emplace();
+  storage->geometry = v.geometry;
+  storage->hu = v.hu;
+  storage->hu_is_int16 = v.hu_is_int16;
+  storage->labels = v.labels;
+  smooth_for_views(*storage, view_smoothing_sigma_voxels(v.geometry, v.smoothing_mm));
+  return *storage;
+}
+
 std::vector<int16_t> voxel_gradients(const RenderVolume& v, bool with_hu) {
   const auto& d = v.geometry.dims;
   std::vector<int16_t> out(std::size_t(v.geometry.voxel_count()) * 4);
@@ -108,6 +165,18 @@ LabelColours default_label_colours() {
   set({18, 19}, 250, 190, 170);    // small bowel, duodenum
   set({20}, 200, 150, 110);        // colon
   return c;
+}
+
+std::vector<uint8_t> label_colour_volume(const RenderVolume& v, const LabelColours& c) {
+  std::vector<uint8_t> out(std::size_t(v.geometry.voxel_count()) * 4, 0);
+  if (v.labels.empty()) return out;
+  const int64_t n = v.geometry.voxel_count();
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < n; ++i) {
+    const auto p = premultiplied_colour(c, v.labels[std::size_t(i)]);
+    std::copy(p.begin(), p.end(), out.begin() + 4 * i);
+  }
+  return out;
 }
 
 BlockRanges block_ranges(const RenderVolume& v) {

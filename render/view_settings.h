@@ -49,6 +49,10 @@ struct CameraPath {
   Optics optics;
 };
 
+/// The width of the Gaussian the views' copy of the CT is prefiltered with, in mm, at least a voxel
+/// on each axis (render_volume.h view_smoothing_sigma_voxels says why).
+inline constexpr double kDefaultSmoothingMm = 1.5;
+
 /// How the views are rendered and from where: the scene's "render" section.
 struct ViewSettings {
   int width = 640, height = 480;
@@ -58,6 +62,7 @@ struct ViewSettings {
   bool show_labels = true;
   double label_opacity = 0.5;
   double light_falloff_mm = 100.0;  // d0 of the headlight's 1/(1+(d/d0)²) (§8)
+  double smoothing_mm = kDefaultSmoothingMm;   // σ of the views' prefilter, ≥ 1 voxel (render_volume.h)
   // Phong coefficients; VTK's defaults for volumes lit by a headlight (ambient low: the scope's
   // own light is the only light in the abdomen).
   double ambient = 0.15, diffuse = 0.85, specular = 0.25, shininess = 12.0;

@@ -8,7 +8,7 @@
 // false uniform condition still costs its full price in every loop iteration.
 //   PACKED         u_vol holds (HU, gradient) in one RGBA16_SNORM texture, so a shaded sample is
 //                  one trilinear fetch (integer HU); else u_vol is HU (R32F) and u_grad the gradient
-//   LABELS         organ colours blended (show_labels)
+//   LABELS         organ colours blended (show_labels), trilinear from premultiplied per-voxel colours
 //   HIDE_EXTERIOR  samples in exterior air contribute nothing (hide_exterior_air)
 
 layout(location = 0) out vec4 out_colour;  // premultiplied RGB over black, accumulated opacity
@@ -18,10 +18,10 @@ uniform sampler3D u_vol;         // PACKED: (HU, gx, gy, gz)/32767 (RGBA16_SNORM
 #ifndef PACKED
 uniform sampler3D u_grad;        // (gx, gy, gz, 0)/32767 (RGBA16_SNORM)
 #endif
-uniform usampler3D u_labels;     // label ids, nearest (texelFetch)
+uniform usampler3D u_labels;     // label ids, nearest (texelFetch): exterior air
+uniform sampler3D u_label_colour; // premultiplied organ colour per voxel (RGBA8, trilinear)
 uniform usampler3D u_occupancy;  // 1 = block may hold something visible
 uniform sampler2D u_tf;          // RGB and step-corrected opacity per HU, u_tf_size entries from u_tf_hu_min
-uniform sampler2D u_label_rgba;  // 256 × 256: id = x + 256·y, RGBA8
 
 uniform vec3 u_inv_dims;         // 1 / voxels per axis
 uniform ivec3 u_dims_i;          // voxels per axis
@@ -65,7 +65,7 @@ uint label_at(vec3 idx) {
 // function entry; false when it contributes nothing.
 bool sample_at(vec3 p, out uint id, out vec4 v, out vec4 tf) {
   id = 0u;
-#if defined(LABELS) || defined(HIDE_EXTERIOR)
+#ifdef HIDE_EXTERIOR
   id = label_at(p);
 #endif
   v = vec4(0.0);
@@ -181,8 +181,8 @@ void main() {
     float a = tf.a;  // already corrected for the step
     vec3 c = tf.rgb;
 #ifdef LABELS
-    vec4 lc = texelFetch(u_label_rgba, ivec2(int(id & 255u), int(id >> 8)), 0);
-    c = mix(c, lc.rgb, u_label_opacity * lc.a);
+    vec4 lc = textureLod(u_label_colour, (p + 0.5) * u_inv_dims, 0.0);
+    c = c * (1.0 - u_label_opacity * lc.a) + u_label_opacity * lc.rgb;
 #endif
 #ifdef PACKED
     vec3 g_idx = v.gba * u_grad_scale;

@@ -155,9 +155,10 @@ OrganPixels organ_pixels(const RenderImage& with, const RenderImage& without) {
 
 // Labels colour what they should: seen from the cavity's centre, the organ (radius 14 mm, centre
 // 35 mm away on the axis) subtends asin(14/35) = 23.6° around the image centre, i.e. a disc of
-// tan(23.6°)/tan(35°) = 0.62 of the half width with a 70° pinhole. Every label-coloured pixel must
-// lie in that disc (+1.5 px for the partial-volume edge and nearest label sampling), the disc's
-// centre must be coloured, and the colour must move towards the liver's dark red (green drops).
+// tan(23.6°)/tan(35°) = 0.62 of the half width with a 70° pinhole. Label colours are interpolated
+// trilinearly (model step 3), so they reach one voxel (1.5 mm) past the labelled voxel centres:
+// every label-coloured pixel must lie in the disc of the organ grown by that voxel (+0.5 px), the
+// disc's centre must be coloured, and the colour must move towards the liver's dark red (green drops).
 TEST(RenderGlLabels, OrganLabelColoursExactlyTheOrgansPixels) {
   PNEUMO_REQUIRE_GL(ctx);
   const CavityPhantom p;
@@ -176,6 +177,7 @@ TEST(RenderGlLabels, OrganLabelColoursExactlyTheOrgansPixels) {
   const OrganPixels o = organ_pixels(with, without);
   EXPECT_TRUE(o.centre);
   const double disc_px = std::tan(std::asin(14.0 / 35.0)) / std::tan(35.0 * kPi / 180.0) * kSize / 2;
+  const double reach_px = std::tan(std::asin((14.0 + p.spacing_mm) / 35.0)) / std::tan(35.0 * kPi / 180.0) * kSize / 2;
   const auto a = to_rgb8(with), b = to_rgb8(without);
   int outside = 0, greener = 0;
   for (int y = 0; y < kSize; ++y)
@@ -184,7 +186,7 @@ TEST(RenderGlLabels, OrganLabelColoursExactlyTheOrgansPixels) {
       const int diff = std::abs(a[3 * n] - b[3 * n]) + std::abs(a[3 * n + 1] - b[3 * n + 1]) +
                        std::abs(a[3 * n + 2] - b[3 * n + 2]);
       if (diff <= 3) continue;
-      if (std::hypot(x + 0.5 - kSize / 2.0, y + 0.5 - kSize / 2.0) > disc_px + 1.5) ++outside;
+      if (std::hypot(x + 0.5 - kSize / 2.0, y + 0.5 - kSize / 2.0) > reach_px + 0.5) ++outside;
       if (a[3 * n + 1] > b[3 * n + 1]) ++greener;
     }
   EXPECT_EQ(outside, 0);

@@ -92,7 +92,8 @@ PortsRun run_ports(const Scene& scene, const PortsRunOptions& o) {
   run.table["simulation"] = run.reused_simulation ? "reused from " + o.out_dir : "solved for this ranking";
 
   // The heat map on the anterior exterior view of the inflated body.
-  const RenderVolume volume = render_volume_of(w.result, w.output_grid);
+  RenderVolume volume = render_volume_of(w.result, w.output_grid);
+  volume.smoothing_mm = scene.render.smoothing_mm;
   Renderer renderer(o.cpu_render, o.backend);
   renderer.set_volume(volume);
   const RenderSettings base = settings_from_scene(scene.render, volume.geometry);

@@ -146,6 +146,7 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Vol
   const fs::path deformed_labels = out / "deformed_labels.nii.gz";
   const PointMapFn map = opt.map_point ? opt.map_point : identity_point_map();
   RenderVolume volume = RenderVolume::from(ct, labels);
+  volume.smoothing_mm = r.smoothing_mm;
   const RenderSettings s = settings_from_scene(r, volume.geometry);
 
   // Poses first: every bad one is reported before any rendering.
@@ -265,7 +266,8 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Vol
     for (const ExteriorCamera& c : cameras) after.push_back(renderer.render(c.camera, skin_settings(s, c.camera, volume.geometry)));
     std::vector<RenderImage> before;
     if (opt.undeformed_ct) {
-      const RenderVolume undeformed = RenderVolume::from(*opt.undeformed_ct, nullptr);
+      RenderVolume undeformed = RenderVolume::from(*opt.undeformed_ct, nullptr);
+      undeformed.smoothing_mm = r.smoothing_mm;
       renderer.set_volume(undeformed);
       for (const ExteriorCamera& c : cameras)
         before.push_back(renderer.render(c.camera, skin_settings(s, c.camera, volume.geometry)));

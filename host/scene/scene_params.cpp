@@ -389,6 +389,10 @@ const Table<ViewSettings>& render_table() {
        "inflation side by side, the ports marked (§8)."},
       {"step_fraction", &ViewSettings::step_fraction, "", above(0, 0.5),
        "Ray step as a fraction of the smallest voxel spacing (§8: at most half)."},
+      {"smoothing_mm", &ViewSettings::smoothing_mm, "mm", in(0, 10),
+       "Sigma of the Gaussian the views' copy of the CT is prefiltered with, at least one voxel on each axis "
+       "(§8): it hides the voxel lattice's terraces and tile mosaic and keeps a fine CT's noise from showing as "
+       "grain (docs/rendering.md); 0 renders the voxels as they are. Measurements always read the CT itself."},
       {"jitter", &ViewSettings::jitter, "", any(), "Offset each ray's start randomly (hides wood-grain bands; images then vary)."},
       {"show_labels", &ViewSettings::show_labels, "", any(),
        "Blend organ label colours over the CT colour (§8) when a label map is given."},

@@ -202,6 +202,7 @@ void PlanningSession::refresh_shape(const Simulation& sim, const Scene& scene, c
   // The views' volume straight from the warp; nothing else holds a copy (the slices and the port
   // ranking read this one).
   auto volume = std::make_unique<RenderVolume>(render_volume_of(w, g));
+  volume->smoothing_mm = scene.render.smoothing_mm;
   const double s_volume = seconds_since(t0) - s_map - s_warp;
   renderer_.set_volume(*volume);
   log::debug("serve: shape refreshed: point map " + std::to_string(s_map) + " s, warp " + std::to_string(s_warp) +
