@@ -1,9 +1,11 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "pipeline/convergence_study.h"
 #include "pipeline/pressure_volume_study.h"
+#include "pipeline/view_resolution_study.h"
 #include "validate/validate.h"
 
 namespace pneumo::cli {
@@ -20,6 +22,9 @@ Run add_validate(CLI::App& app) {
     std::string scene;
     std::vector<int> cube_voxels{4, 3, 2, 1};
     std::vector<double> pressures = default_pressure_volume_pressures();
+    ViewResolutionOptions views;
+    std::vector<std::string> sizes{"small", "medium", "large"};
+    bool cpu_render = false;
   };
   auto o = std::make_shared<Opts>();
   auto* lattice = cmd->add_subcommand("lattice", "Effective Young's modulus of the cube lattice along an axis (method.md §4: 1.140·E)");
@@ -61,7 +66,46 @@ Run add_validate(CLI::App& app) {
       ->delimiter(',')
       ->capture_default_str();
   pv->add_flag("--json", o->json, "Print JSON (curve, compliance_ml_per_mmhg, fraction_of_30_at_15)");
+  auto* vr = cmd->add_subcommand(
+      "view-resolution",
+      "The phantom rendered at 4, 1.5 and 0.75 mm from the same cameras: SSIM and PSNR of each view against the finest");
+  vr->add_option("--out", o->views.out_dir, "Folder for the views, the solved case and study.json")
+      ->default_val("out/view_resolution");
+  vr->add_option("--sizes", o->sizes, "Phantom sizes, coarse to fine; the last is the reference")
+      ->delimiter(',')
+      ->capture_default_str()
+      ->check(CLI::IsMember({"small", "medium", "large"}));
+  vr->add_option("--width", o->views.width, "View width in pixels")->capture_default_str()->check(CLI::Range(32, 4096));
+  vr->add_option("--height", o->views.height, "View height in pixels")->capture_default_str()->check(CLI::Range(32, 4096));
+  vr->add_flag("--cpu-render", o->cpu_render, "Render with the CPU reference instead of OpenGL (slow)");
+  vr->add_flag("--write-volumes", o->views.write_volumes,
+               "Also write the volumes and cameras a peer renderer needs (bench/peers/vtk_view_resolution.py)");
+  vr->add_flag("--json", o->json, "Print JSON (rows of view, size, shading, ssim, psnr_db)");
   return [=] {
+    if (vr->parsed()) {
+      o->views.sizes.clear();
+      for (const std::string& n : o->sizes) o->views.sizes.push_back(parse_phantom_size(n));
+      for (std::size_t i = 1; i < o->views.sizes.size(); ++i)
+        if (phantom_geometry(o->views.sizes[i]).spacing_mm.maxCoeff() >=
+            phantom_geometry(o->views.sizes[i - 1]).spacing_mm.maxCoeff())
+          throw InputError("validate view-resolution: list --sizes from coarse to fine, e.g. small,medium,large");
+      o->views.cpu_reference = o->cpu_render;
+      const ViewResolutionStudy s = view_resolution_study(o->views);
+      const nlohmann::json j = to_json(s);
+      write_text_file_atomic(o->views.out_dir + "/study.json", j.dump(2) + "\n");
+      if (o->json) {
+        std::cout << j.dump(2) << "\n";
+        return 0;
+      }
+      std::printf("%-20s %-8s %-8s %-11s %-8s %-9s %s\n", "view", "size", "shading", "spacing_mm", "ssim", "psnr_db",
+                  "frame_s");
+      for (const ViewResolutionRow& r : s.rows)
+        std::printf("%-20s %-8s %-8s %-11.2f %-8.3f %-9.1f %.2f\n", r.view.c_str(), r.size.c_str(), r.shading.c_str(),
+                    r.spacing_mm, r.ssim, r.psnr_db, r.frame_seconds);
+      std::printf("views in %s/views; one solve of %.1f s; %.1f s in all\n", o->views.out_dir.c_str(), s.solve_seconds,
+                  s.seconds);
+      return 0;
+    }
     if (pv->parsed()) {
       const PressureVolumeStudy s = pressure_volume_study(load_scene(o->scene), o->pressures);
       if (o->json) {
