@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs every build and run dependency of pneumo from Debian 12 packages.
 # Idempotent and non-interactive; run as root (or with sudo available).
-#   --peers  also what the peer tools in ../shared/peers need beyond the tests' set (SciPy, GLEW), for bench/peers/.
+#   --peers  also what the peer tools need beyond the tests' set, for bench/peers/: SciPy, GLEW, and Xvfb
+#            (VTK's offscreen window on Debian's build needs an X server: vtk_view_resolution.py).
 set -euo pipefail
 
 packages=(
@@ -33,7 +34,7 @@ packages=(
   snakemake python3-matplotlib
 )
 if [ "${1:-}" = "--peers" ]; then
-  packages+=(python3-scipy libglew-dev)
+  packages+=(python3-scipy libglew-dev xvfb xauth)
 fi
 
 SUDO=""
