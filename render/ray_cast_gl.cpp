@@ -169,7 +169,7 @@ void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
   // SNORM maps s to s/32767 exactly for s in ±32767 and filters in floating point.
   m.packed = v.hu_is_int16 && !force_float;
   std::optional<RenderVolume> smoothed;
-  const RenderVolume& viewed = volume_as_viewed(v, smoothed);
+  const RenderVolume& viewed = volume_as_viewed(v, smoothed, /*with_labels=*/false);
   const std::vector<int16_t> grad = voxel_gradients(viewed, m.packed);
   if (m.packed) {  // (HU, gx, gy, gz): one fetch per shaded sample
     g.TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA16_SNORM, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RGBA,
@@ -198,7 +198,7 @@ void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
   gl::check_error("label upload");
   m.geometry = v.geometry;
   m.w2i = v.world_to_index();
-  m.ranges = block_ranges(viewed);
+  m.ranges = block_ranges(viewed, v.labels);
   m.occ_key.reset();
   m.volume = &v;
   m.colours_uploaded.reset();

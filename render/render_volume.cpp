@@ -66,53 +66,114 @@ Vec3 view_smoothing_sigma_voxels(const Geometry& g, double smoothing_mm) {
   return s;
 }
 
-void smooth_for_views(RenderVolume& v, const Vec3& sigma_voxels) {
-  if (!(sigma_voxels.minCoeff() > 0.0) || v.hu.empty()) return;
-  const Index3 d = v.geometry.dims;
-  const int64_t stride[3] = {1, d[0], d[0] * d[1]};
-  std::vector<float> tmp(v.hu.size());
-  // One pass per axis, from v.hu into tmp and back: each line read once into a buffer.
-  for (int a = 0; a < 3; ++a) {
-    const double sigma = sigma_voxels[a];
-    const int radius = std::max(1, int(std::ceil(3.0 * sigma)));
-    std::vector<double> w(std::size_t(2 * radius + 1));
-    double sum = 0.0;
-    for (int r = -radius; r <= radius; ++r) sum += w[std::size_t(r + radius)] = std::exp(-0.5 * r * r / (sigma * sigma));
-    for (double& x : w) x /= sum;
-    const int b = (a + 1) % 3, c = (a + 2) % 3;
-    const int64_t n = d[a];
-    const std::vector<float>& in = a % 2 == 0 ? v.hu : tmp;
-    std::vector<float>& out = a % 2 == 0 ? tmp : v.hu;
+namespace {
+
+// Taps of a Gaussian of σ voxels truncated at ⌈3σ⌉ and renormalised.
+std::vector<float> gaussian_taps(double sigma) {
+  const int radius = std::max(1, int(std::ceil(3.0 * sigma)));
+  std::vector<double> w(std::size_t(2 * radius + 1));
+  double sum = 0.0;
+  for (int r = -radius; r <= radius; ++r) sum += w[std::size_t(r + radius)] = std::exp(-0.5 * r * r / (sigma * sigma));
+  std::vector<float> f(w.size());
+  for (std::size_t i = 0; i < w.size(); ++i) f[i] = float(w[i] / sum);
+  return f;
+}
+
+// out[row] = Σ_r w[r]·in_row(r): rows of `n` floats, summed tap by tap so the inner loop runs along
+// the row (vectorised, streaming).
+inline void weighted_rows(float* out, const std::vector<const float*>& rows, const std::vector<float>& w, int64_t n) {
+  std::fill(out, out + n, 0.0f);
+  for (std::size_t r = 0; r < w.size(); ++r) {
+    const float* in = rows[r];
+    const float wr = w[r];
+    for (int64_t i = 0; i < n; ++i) out[i] += wr * in[i];
+  }
+}
+
+// The three passes of smooth_for_views from `src` into `a` (with `b` as scratch), each laid out so
+// that its inner loop runs along contiguous memory: along i a padded copy of the row, along j and k
+// whole rows weighted and summed (k innermost per j, so the rows a tap reuses stay in cache).
+void gaussian_filter(const float* src, float* a, float* b, const Index3& d, const Vec3& sigma) {
+  const int64_t nx = d[0], ny = d[1], nz = d[2];
+  {  // along i: src → b
+    const std::vector<float> w = gaussian_taps(sigma[0]);
+    const int64_t R = int64_t(w.size() / 2);
 #pragma omp parallel
     {
-      std::vector<double> line(std::size_t(n + 2 * radius));
+      std::vector<float> line(std::size_t(nx + 2 * R));
+      std::vector<const float*> rows(w.size());
 #pragma omp for schedule(static)
-      for (int64_t q = 0; q < d[b] * d[c]; ++q) {
-        const int64_t base = (q % d[b]) * stride[b] + (q / d[b]) * stride[c];
-        for (int64_t t = -radius; t < n + radius; ++t)
-          line[std::size_t(t + radius)] = in[std::size_t(base + std::clamp<int64_t>(t, 0, n - 1) * stride[a])];
-        for (int64_t t = 0; t < n; ++t) {
-          double acc = 0.0;
-          for (int r = 0; r <= 2 * radius; ++r) acc += w[std::size_t(r)] * line[std::size_t(t + r)];
-          out[std::size_t(base + t * stride[a])] = float(acc);
-        }
+      for (int64_t q = 0; q < ny * nz; ++q) {
+        const float* in = src + q * nx;
+        for (int64_t t = -R; t < nx + R; ++t) line[std::size_t(t + R)] = in[std::clamp<int64_t>(t, 0, nx - 1)];
+        for (std::size_t r = 0; r < w.size(); ++r) rows[r] = line.data() + r;
+        weighted_rows(b + q * nx, rows, w, nx);
       }
     }
   }
-  // Three passes end in tmp.
-  v.hu.swap(tmp);
-  if (v.hu_is_int16)
-    for (float& x : v.hu) x = std::nearbyint(std::clamp(x, -32767.0f, 32767.0f));
+  {  // along j: b → a
+    const std::vector<float> w = gaussian_taps(sigma[1]);
+    const int64_t R = int64_t(w.size() / 2);
+#pragma omp parallel
+    {
+      std::vector<const float*> rows(w.size());
+#pragma omp for schedule(static)
+      for (int64_t q = 0; q < ny * nz; ++q) {
+        const int64_t j = q % ny, k = q / ny;
+        for (int64_t r = 0; r < int64_t(w.size()); ++r)
+          rows[std::size_t(r)] = b + (k * ny + std::clamp<int64_t>(j + r - R, 0, ny - 1)) * nx;
+        weighted_rows(a + q * nx, rows, w, nx);
+      }
+    }
+  }
+  {  // along k: a → b, then b → a by a copy-free swap of roles at the caller
+    const std::vector<float> w = gaussian_taps(sigma[2]);
+    const int64_t R = int64_t(w.size() / 2);
+#pragma omp parallel
+    {
+      std::vector<const float*> rows(w.size());
+#pragma omp for schedule(static)
+      for (int64_t j = 0; j < ny; ++j)
+        for (int64_t k = 0; k < nz; ++k) {
+          for (int64_t r = 0; r < int64_t(w.size()); ++r)
+            rows[std::size_t(r)] = a + (std::clamp<int64_t>(k + r - R, 0, nz - 1) * ny + j) * nx;
+          weighted_rows(b + (k * ny + j) * nx, rows, w, nx);
+        }
+    }
+  }
 }
 
-const RenderVolume& volume_as_viewed(const RenderVolume& v, std::optional<RenderVolume>& storage) {
+}  // namespace
+
+void smooth_for_views(RenderVolume& v, const Vec3& sigma_voxels) {
+  if (!(sigma_voxels.minCoeff() > 0.0) || v.hu.empty()) return;
+  std::vector<float> a(v.hu.size()), b(v.hu.size());
+  gaussian_filter(v.hu.data(), a.data(), b.data(), v.geometry.dims, sigma_voxels);
+  v.hu.swap(b);   // the last pass wrote b
+  if (v.hu_is_int16) {
+    float* h = v.hu.data();
+    const int64_t n = int64_t(v.hu.size());
+#pragma omp parallel for schedule(static)
+    for (int64_t i = 0; i < n; ++i) h[i] = std::nearbyint(std::clamp(h[i], -32767.0f, 32767.0f));
+  }
+}
+
+const RenderVolume& volume_as_viewed(const RenderVolume& v, std::optional<RenderVolume>& storage, bool with_labels) {
   if (!(v.smoothing_mm > 0.0)) return v;
   storage.emplace();
   storage->geometry = v.geometry;
-  storage->hu = v.hu;
   storage->hu_is_int16 = v.hu_is_int16;
-  storage->labels = v.labels;
-  smooth_for_views(*storage, view_smoothing_sigma_voxels(v.geometry, v.smoothing_mm));
+  if (with_labels) storage->labels = v.labels;
+  const Vec3 sigma = view_smoothing_sigma_voxels(v.geometry, v.smoothing_mm);
+  std::vector<float> scratch(v.hu.size());
+  storage->hu.resize(v.hu.size());
+  gaussian_filter(v.hu.data(), scratch.data(), storage->hu.data(), v.geometry.dims, sigma);
+  if (v.hu_is_int16) {
+    float* h = storage->hu.data();
+    const int64_t n = int64_t(v.hu.size());
+#pragma omp parallel for schedule(static)
+    for (int64_t i = 0; i < n; ++i) h[i] = std::nearbyint(std::clamp(h[i], -32767.0f, 32767.0f));
+  }
   return *storage;
 }
 
@@ -179,7 +240,9 @@ std::vector<uint8_t> label_colour_volume(const RenderVolume& v, const LabelColou
   return out;
 }
 
-BlockRanges block_ranges(const RenderVolume& v) {
+BlockRanges block_ranges(const RenderVolume& v) { return block_ranges(v, v.labels); }
+
+BlockRanges block_ranges(const RenderVolume& v, const std::vector<uint16_t>& labels) {
   const auto& d = v.geometry.dims;
   const int B = kOccupancyBlock;
   BlockRanges r;
@@ -188,7 +251,7 @@ BlockRanges block_ranges(const RenderVolume& v) {
   r.min_hu.assign(nb, 0);
   r.max_hu.assign(nb, 0);
   r.all_exterior.assign(nb, 0);
-  const bool has_labels = !v.labels.empty();
+  const bool has_labels = !labels.empty();
 #pragma omp parallel for schedule(dynamic)
   for (int64_t b = 0; b < nb; ++b) {
     const int64_t bx = b % r.blocks[0], by = (b / r.blocks[0]) % r.blocks[1], bz = b / (r.blocks[0] * r.blocks[1]);
@@ -201,7 +264,7 @@ BlockRanges block_ranges(const RenderVolume& v) {
           const int64_t n = v.geometry.linear_index(i, j, k);
           lo = std::min(lo, v.hu[n]);
           hi = std::max(hi, v.hu[n]);
-          if (has_labels && v.labels[n] != kExteriorAirLabel) exterior = false;
+          if (has_labels && labels[n] != kExteriorAirLabel) exterior = false;
         }
     r.min_hu[b] = lo;
     r.max_hu[b] = hi;

@@ -68,8 +68,10 @@ void smooth_for_views(RenderVolume& v, const Vec3& sigma_voxels);
 Vec3 view_smoothing_sigma_voxels(const Geometry& g, double smoothing_mm);
 
 /// The volume as the ray casters sample it: `v` itself when v.smoothing_mm ≤ 0, else a copy in
-/// `storage` filtered by smooth_for_views (labels copied as they are).
-const RenderVolume& volume_as_viewed(const RenderVolume& v, std::optional<RenderVolume>& storage);
+/// `storage` filtered by smooth_for_views, its labels copied when `with_labels`. Filtered straight
+/// from v.hu: one copy's worth of memory beside the result, not two.
+const RenderVolume& volume_as_viewed(const RenderVolume& v, std::optional<RenderVolume>& storage,
+                                     bool with_labels = true);
 
 /// Shading gradients (render_settings.h, model step 4), one per voxel, computed once per volume:
 /// along each index axis the central difference of the voxel HU, h[i+1] − h[i−1] with indices
@@ -138,6 +140,8 @@ struct BlockRanges {
 };
 /// Per-block HU ranges (computed once per volume).
 BlockRanges block_ranges(const RenderVolume& v);
+/// The same with the exterior-air test on `labels` (empty: none) instead of v.labels.
+BlockRanges block_ranges(const RenderVolume& v, const std::vector<uint16_t>& labels);
 /// The occupancy of each block under a transfer function.
 OccupancyGrid occupancy(const BlockRanges& r, const TransferFunction& tf, bool hide_exterior);
 
