@@ -65,6 +65,10 @@ const Bench& bench() {
   Progress::set_enabled(false);
   const Phantom ph = make_phantom(PhantomSize::Large);
   b->volume = RenderVolume::from(ph.ct, &ph.labels);
+  // As the render stage reconstructs it (render.smoothing_mm's default); PNEUMO_BENCH_SMOOTHING_MM=0
+  // times the voxels as they are.
+  const char* smoothing = std::getenv("PNEUMO_BENCH_SMOOTHING_MM");
+  b->volume.smoothing_mm = smoothing ? std::atof(smoothing) : kDefaultSmoothingMm;
   RenderVolume& v = b->volume;
   const Geometry& g = v.geometry;
   const uint8_t* lab = ph.labels.data<uint8_t>();
