@@ -9,6 +9,8 @@
 #include <filesystem>
 
 #include "cli_test_support.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
 #include "io_test_support.h"
 #include "pipeline/view_resolution_study.h"
 #include "render_test_support.h"
@@ -42,6 +44,9 @@ TEST(ViewResolutionStudy, SmoothViewsAgreeAcrossResolutionsBetterThanVoxels) {
   }
   EXPECT_GT(port_smooth, port_voxel + 0.1);
   EXPECT_GT(s.solve_seconds, 0.0);
+  // study.json is the caller's (the CLI's) to write; a folder holding one is refused without force.
+  write_text_file_atomic((d.path() / "study.json").string(), "{}");
+  EXPECT_THROW(view_resolution_study(o), InputError);
 }
 
 TEST(ViewResolutionStudy, SizesMustRunCoarseToFine) {

@@ -78,6 +78,7 @@ Run add_validate(CLI::App& app) {
   vr->add_option("--width", o->views.width, "View width in pixels")->capture_default_str()->check(CLI::Range(32, 4096));
   vr->add_option("--height", o->views.height, "View height in pixels")->capture_default_str()->check(CLI::Range(32, 4096));
   vr->add_flag("--cpu-render", o->cpu_render, "Render with the CPU reference instead of OpenGL (slow)");
+  vr->add_flag("--force", o->views.force, "Replace the study.json of an earlier study in --out");
   vr->add_flag("--write-volumes", o->views.write_volumes,
                "Also write the volumes and cameras a peer renderer needs (bench/peers/vtk_view_resolution.py)");
   vr->add_flag("--json", o->json, "Print JSON (rows of view, size, shading, ssim, psnr_db)");

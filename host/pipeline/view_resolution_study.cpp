@@ -100,6 +100,8 @@ constexpr Shading kShadings[] = {{"voxel", 0.0}, {"smooth", kDefaultSmoothingMm}
 
 ViewResolutionStudy view_resolution_study(const ViewResolutionOptions& o) {
   if (o.sizes.size() < 2) throw InputError("validate view-resolution: give at least 2 sizes");
+  if (!o.force && fs::exists(fs::path(o.out_dir) / "study.json"))
+    throw InputError(o.out_dir + ": already holds a view-resolution study (study.json); use --force to replace it");
   const auto start = std::chrono::steady_clock::now();
   ViewResolutionStudy s;
   const fs::path out(o.out_dir);

@@ -27,6 +27,7 @@ struct ViewResolutionOptions {
   /// volumes/<size>_ct.mhd and <size>_deformed_ct.mhd (MetaImage, HU as rendered, before the views'
   /// prefilter) and peer_views.json (cameras, transfer functions, lighting, step per size).
   bool write_volumes = false;
+  bool force = false;             // replace an earlier study in out_dir (else InputError before any work)
 };
 
 struct ViewResolutionRow {
