@@ -291,6 +291,8 @@ RenderImage GlRayCaster::render(const ViewCamera& cam, const RenderSettings& s) 
   u1("u_specular", s.specular);
   u1("u_shininess", s.shininess);
   u1("u_falloff", s.light_falloff_mm);
+  g.Uniform2f(prog.uniform("u_pixel_offset"), float(s.pixel_offset_x), float(s.pixel_offset_y));
+  u1("u_vignetting", s.vignetting_power);
   gl::check_error("uniforms");
 
   g.BindFramebuffer(GL_FRAMEBUFFER, m.fbo);

@@ -102,7 +102,7 @@ RenderImage render_reference(const RenderVolume& input, const ViewCamera& cam, c
 #pragma omp parallel for schedule(dynamic, 1)
   for (int py = 0; py < cam.height; ++py) {
     for (int px = 0; px < cam.width; ++px) {
-      const auto dir = cam.ray(px + 0.5, py + 0.5);
+      const auto dir = cam.ray(px + 0.5 + s.pixel_offset_x, py + 0.5 + s.pixel_offset_y);
       if (!dir) continue;
       const Vec3 didx = w2i * *dir;  // index units per mm along the ray
       const auto [ta, tb] = clip_to_box(origin_idx, didx, volume.geometry.dims);
@@ -166,6 +166,7 @@ RenderImage render_reference(const RenderVolume& input, const ViewCamera& cam, c
         if (A > kEarlyTermination) break;
       }
       const std::size_t n = std::size_t(py) * cam.width + px;
+      if (s.vignetting_power > 0.0) C *= std::pow(std::max(0.0, cam.forward.dot(*dir)), s.vignetting_power);
       for (int c = 0; c < 3; ++c) img.rgba[4 * n + c] = float(std::clamp(C[c], 0.0, 1.0));
       img.rgba[4 * n + 3] = float(A);
       img.depth_mm[n] = float(depth);

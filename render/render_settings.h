@@ -5,7 +5,8 @@
 // 0. Volume: the CT as RenderVolume::smoothing_mm reconstructs it (smooth_for_views in
 //    render_volume.h: a Gaussian prefilter of the views' copy); every HU and gradient below is read
 //    from that copy, labels from the volume itself.
-// 1. Ray: from the camera's tip along ViewCamera::ray() of the pixel centre. It is clipped to the
+// 1. Ray: from the camera's tip along ViewCamera::ray() of the pixel centre moved by the settings'
+//    pixel offset, (px + ½ + ox, py + ½ + oy) (0 but in an anti-aliasing pass, step 7). It is clipped to the
 //    box of voxel centres (index space [0, dims−1]); samples sit at t_k = near + (k + j)·Δs mm for
 //    the k with t_k inside the clipped interval; j = 0, or with jitter a per-pixel hash in [0, 1)
 //    (jitter_offset(), the same bits on both sides, so jittered images still compare).
@@ -36,7 +37,16 @@
 //    and specular = 0.
 // 5. Front to back: C += (1 − A)·α′·shaded, A += (1 − A)·α′; stop once A > 0.99 (early termination).
 //    Depth: the first t at which A ≥ 0.5 (the first surface); none when A stays below.
-// 6. Output: C clamped to [0, 1] over a black background (premultiplied), A, depth in mm.
+// 6. Output: C clamped to [0, 1] over a black background (premultiplied), A, depth in mm. With
+//    vignetting_power n > 0, C is first multiplied by cosⁿ of the ray's angle to the view direction
+//    (forward·dir): n = 4 is the cos⁴ law of a lens's relative illumination, the darkening towards
+//    a laparoscope image's rim; the headlight's falloff (step 4) is the other half of that look.
+// 7. Anti-aliasing (Renderer::render): with antialias_samples N > 1, the mean colour and opacity
+//    of N passes whose pixel offsets are antialias_offset(0 … N−1) (the first (0, 0)) and whose
+//    jitter seeds are jitter_seed + pass (jitter on): a box filter over the pixel and the step,
+//    sampled by a low-discrepancy set. Depth is the first pass's.
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -57,7 +67,19 @@ struct RenderSettings {
   bool hide_exterior_air = false;
   double ambient = 0.15, diffuse = 0.85, specular = 0.25, shininess = 12.0;
   double light_falloff_mm = 100.0;
+  double vignetting_power = 0.0;                        // step 6; 0: none
+  double pixel_offset_x = 0.0, pixel_offset_y = 0.0;    // step 1, in pixels
+  int antialias_samples = 1;                            // step 7
 };
+
+/// Pass k's pixel offset (step 7): the R2 sequence (Roberts 2018, the plastic number's
+/// low-discrepancy 2-D set), centred on the pixel, pass 0 at its centre.
+inline std::array<double, 2> antialias_offset(int k) {
+  if (k == 0) return {0.0, 0.0};
+  constexpr double g = 1.32471795724474602596;   // the plastic number
+  const double x = std::fmod(0.5 + k / g, 1.0), y = std::fmod(0.5 + k / (g * g), 1.0);
+  return {x - 0.5, y - 0.5};
+}
 
 inline constexpr double kOpacityUnitMm = 1.0;       // Δs_ref of the opacity correction
 inline constexpr double kEarlyTermination = 0.99;   // stop compositing once A exceeds this

@@ -21,11 +21,14 @@ class Renderer {
   Renderer(bool cpu_reference, GlBackend backend);
   /// The volume every later render() draws; it must outlive them (the GL path uploads it once).
   void set_volume(const RenderVolume& v);
+  /// One view; with settings.antialias_samples > 1 the mean of that many passes (render_settings.h,
+  /// model step 7).
   RenderImage render(const ViewCamera& camera, const RenderSettings& settings);
   /// What rendered: {"renderer": "cpu-reference"} or the GL back end, version, renderer, vendor.
   nlohmann::json describe() const;
 
  private:
+  RenderImage render_pass(const ViewCamera& camera, const RenderSettings& settings);
   std::unique_ptr<GlRayCaster> gl_;   // null: the CPU reference
   const RenderVolume* volume_ = nullptr;
 };

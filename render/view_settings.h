@@ -63,6 +63,8 @@ struct ViewSettings {
   double label_opacity = 0.5;
   double light_falloff_mm = 100.0;  // d0 of the headlight's 1/(1+(d/d0)²) (§8)
   double smoothing_mm = kDefaultSmoothingMm;   // σ of the views' prefilter, ≥ 1 voxel (render_volume.h)
+  double vignetting_power = 0.0;   // laparoscope views × cosⁿ of the field angle (render_settings.h step 6)
+  int antialias_samples = 1;       // passes averaged per view (render_settings.h step 7)
   // Phong coefficients; VTK's defaults for volumes lit by a headlight (ambient low: the scope's
   // own light is the only light in the abdomen).
   double ambient = 0.15, diffuse = 0.85, specular = 0.25, shininess = 12.0;

@@ -45,6 +45,8 @@ uniform int u_jitter;
 uniform uint u_seed;
 uniform float u_label_opacity;
 uniform float u_ambient, u_diffuse, u_specular, u_shininess, u_falloff;
+uniform vec2 u_pixel_offset;     // model step 1: the ray through the pixel centre moved by this
+uniform float u_vignetting;      // model step 6: colour × (forward·dir)^n; 0: none
 
 const uint kExteriorAir = 65535u;
 const float kEarlyTermination = 0.99;
@@ -108,7 +110,9 @@ void main() {
   out_colour = vec4(0.0);
   out_depth = -1.0;
   // Pixel centre with the top row first, as the CPU reference counts them.
-  vec2 pix = vec2(gl_FragCoord.x, u_image.y - gl_FragCoord.y);
+  vec2 centre = vec2(gl_FragCoord.x, u_image.y - gl_FragCoord.y);
+  uvec2 pixel = uvec2(centre);   // the pixel's own index: the jitter hash does not move with the offset
+  vec2 pix = centre + u_pixel_offset;
   float x = 2.0 * pix.x / u_image.x - 1.0;
   float y = (1.0 - 2.0 * pix.y / u_image.y) * u_image.y / u_image.x;
   vec3 dir;
@@ -127,7 +131,7 @@ void main() {
   vec2 tc = clip_box(o, d, vec3(0.0), dims - 1.0);
   float t_lo = max(tc.x, u_near), t_hi = tc.y;
   if (!(t_lo <= t_hi)) return;
-  float j = u_jitter != 0 ? jitter_offset(uint(pix.x), uint(pix.y), u_seed) : 0.0;
+  float j = u_jitter != 0 ? jitter_offset(pixel.x, pixel.y, u_seed) : 0.0;
   int k = max(0, int(ceil((t_lo - u_near) / u_step - j)));
 
   // Loop invariants of the block jump: the far face of a block along each axis, and 1/d.
@@ -202,5 +206,6 @@ void main() {
     if (A >= kDepthOpacity && out_depth < 0.0) out_depth = t;
     if (A > kEarlyTermination) break;
   }
+  if (u_vignetting > 0.0) C *= pow(max(dot(u_forward, dir), 0.0), u_vignetting);
   out_colour = vec4(clamp(C, 0.0, 1.0), A);
 }

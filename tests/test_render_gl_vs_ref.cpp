@@ -36,6 +36,7 @@ struct Case {
   RenderPreset preset = RenderPreset::Laparoscopic;
   bool force_float = false, jitter = false, rotated_grid = false, exterior = false;
   double min_covered = 0.9;
+  double vignetting_power = 0, offset_x = 0, offset_y = 0, smoothing_mm = 0;
 };
 
 Optics lens(Lens l, double fov, double oblique = 0, double roll = 0) {
@@ -60,6 +61,14 @@ std::vector<Case> cases() {
   c.push_back({"rotated_grid", inside, organ, lens(Lens::Pinhole, 70), RenderPreset::Laparoscopic, false, false,
                true});
   c.push_back({"ct_muscle_90", inside, organ, lens(Lens::Pinhole, 90), RenderPreset::CtMuscle});
+  Case vignetted{"vignetting_offset", inside, organ, lens(Lens::Pinhole, 70)};
+  vignetted.vignetting_power = 4;
+  vignetted.offset_x = 0.3;
+  vignetted.offset_y = -0.2;
+  c.push_back(vignetted);
+  Case smoothed{"smoothed_3mm", inside, organ, lens(Lens::Pinhole, 70)};
+  smoothed.smoothing_mm = 3.0;   // σ = 2 voxels of 1.5 mm
+  c.push_back(smoothed);
   c.push_back({"exterior_ct_air", Vec3(0, 150, 40), Vec3(0, 0, 0), lens(Lens::Pinhole, 40), RenderPreset::CtAir,
                false, false, false, true, 0.2});
   return c;
@@ -77,7 +86,11 @@ TEST_P(RenderGlVsRef, ImagesAgreeByPsnrAndAreNotBlank) {
     p.k_spacing_mm = 2.0;
   }
   RenderVolume v = make_cavity_phantom(p, dir);
+  v.smoothing_mm = k.smoothing_mm;
   RenderSettings s;
+  s.vignetting_power = k.vignetting_power;
+  s.pixel_offset_x = k.offset_x;
+  s.pixel_offset_y = k.offset_y;
   s.tf = preset_transfer_function(k.preset);
   s.step_mm = 0.5 * v.geometry.spacing_mm.minCoeff();
   s.jitter = k.jitter;

@@ -76,6 +76,7 @@ RenderSettings skin_settings(const RenderSettings& s, const ViewCamera& camera, 
   e.tf = preset_transfer_function(RenderPreset::Skin);
   e.show_labels = false;
   e.hide_exterior_air = false;
+  e.vignetting_power = 0.0;   // a camera outside the body, not through the scope
   e.light_falloff_mm = (camera.position_mm - grid_frame(g).centre).norm();
   return e;
 }

@@ -77,6 +77,8 @@ RenderSettings settings_from_scene(const ViewSettings& r, const Geometry& g) {
   s.specular = r.specular;
   s.shininess = r.shininess;
   s.light_falloff_mm = r.light_falloff_mm;
+  s.vignetting_power = r.vignetting_power;
+  s.antialias_samples = r.antialias_samples;
   return s;
 }
 

@@ -393,6 +393,12 @@ const Table<ViewSettings>& render_table() {
        "Sigma of the Gaussian the views' copy of the CT is prefiltered with, at least one voxel on each axis "
        "(§8): it hides the voxel lattice's terraces and tile mosaic and keeps a fine CT's noise from showing as "
        "grain (docs/rendering.md); 0 renders the voxels as they are. Measurements always read the CT itself."},
+      {"vignetting_power", &ViewSettings::vignetting_power, "", in(0, 8),
+       "Laparoscope views darken towards the rim as cos^n of the ray's angle to the view direction (§8): 4 is "
+       "the cos^4 law of a lens's relative illumination; 0 none. Exterior views never."},
+      {"antialias_samples", &ViewSettings::antialias_samples, "", in(1, 64),
+       "Each view the mean of this many passes, each at another point of the pixel (a low-discrepancy set) "
+       "with its own step jitter: smooth silhouettes, at this many times the frame time (§8)."},
       {"jitter", &ViewSettings::jitter, "", any(), "Offset each ray's start randomly (hides wood-grain bands; images then vary)."},
       {"show_labels", &ViewSettings::show_labels, "", any(),
        "Blend organ label colours over the CT colour (§8) when a label map is given."},
