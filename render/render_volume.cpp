@@ -143,6 +143,14 @@ void gaussian_filter(const float* src, float* a, float* b, const Index3& d, cons
   }
 }
 
+// Whole HU, as a 16-bit texture holds them (hu_is_int16).
+void round_to_int16_hu(std::vector<float>& hu) {
+  float* h = hu.data();
+  const int64_t n = int64_t(hu.size());
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < n; ++i) h[i] = std::nearbyint(std::clamp(h[i], -32767.0f, 32767.0f));
+}
+
 }  // namespace
 
 void smooth_for_views(RenderVolume& v, const Vec3& sigma_voxels) {
@@ -150,12 +158,7 @@ void smooth_for_views(RenderVolume& v, const Vec3& sigma_voxels) {
   std::vector<float> a(v.hu.size()), b(v.hu.size());
   gaussian_filter(v.hu.data(), a.data(), b.data(), v.geometry.dims, sigma_voxels);
   v.hu.swap(b);   // the last pass wrote b
-  if (v.hu_is_int16) {
-    float* h = v.hu.data();
-    const int64_t n = int64_t(v.hu.size());
-#pragma omp parallel for schedule(static)
-    for (int64_t i = 0; i < n; ++i) h[i] = std::nearbyint(std::clamp(h[i], -32767.0f, 32767.0f));
-  }
+  if (v.hu_is_int16) round_to_int16_hu(v.hu);
 }
 
 const RenderVolume& volume_as_viewed(const RenderVolume& v, std::optional<RenderVolume>& storage, bool with_labels) {
@@ -168,12 +171,7 @@ const RenderVolume& volume_as_viewed(const RenderVolume& v, std::optional<Render
   std::vector<float> scratch(v.hu.size());
   storage->hu.resize(v.hu.size());
   gaussian_filter(v.hu.data(), scratch.data(), storage->hu.data(), v.geometry.dims, sigma);
-  if (v.hu_is_int16) {
-    float* h = storage->hu.data();
-    const int64_t n = int64_t(v.hu.size());
-#pragma omp parallel for schedule(static)
-    for (int64_t i = 0; i < n; ++i) h[i] = std::nearbyint(std::clamp(h[i], -32767.0f, 32767.0f));
-  }
+  if (v.hu_is_int16) round_to_int16_hu(storage->hu);
   return *storage;
 }
 

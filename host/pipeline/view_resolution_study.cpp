@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/stopwatch.h"
 #include "core/log.h"
 #include "io/volume.h"
 #include "io/volume_io.h"
@@ -28,10 +29,6 @@ namespace pneumo {
 namespace {
 
 constexpr int kStomachLabel = 6;   // TotalSegmentator v2 "stomach", as the phantom's labels
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// The phantom's scene for `size`, its inputs read from memory (paths are never opened here).
 Scene phantom_scene(PhantomSize size, const fs::path& dir) {
