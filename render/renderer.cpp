@@ -12,7 +12,15 @@ Renderer::Renderer(bool cpu_reference, GlBackend backend) {
 
 void Renderer::set_volume(const RenderVolume& v) {
   volume_ = &v;
-  if (gl_) gl_->set_volume(v);
+  viewed_.reset();
+  if (gl_) {
+    gl_->set_volume(v);
+  } else if (v.smoothing_mm > 0.0) {
+    // The reference would filter on every frame: filter once here, and hand it the filtered copy.
+    volume_as_viewed(v, viewed_);
+    viewed_->smoothing_mm = 0.0;
+    volume_ = &*viewed_;
+  }
 }
 
 RenderImage Renderer::render_pass(const ViewCamera& camera, const RenderSettings& settings) {

@@ -4,6 +4,7 @@
 // here. Both implement render_settings.h's model and are held to each other by
 // tests/test_render_gl_vs_ref.cpp.
 #include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -31,6 +32,7 @@ class Renderer {
   RenderImage render_pass(const ViewCamera& camera, const RenderSettings& settings);
   std::unique_ptr<GlRayCaster> gl_;   // null: the CPU reference
   const RenderVolume* volume_ = nullptr;
+  std::optional<RenderVolume> viewed_;   // the reference path's filtered copy (smoothing_mm > 0)
 };
 
 }  // namespace pneumo
