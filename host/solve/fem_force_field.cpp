@@ -13,6 +13,9 @@
 // The stiffness product for a direction p (δF_t = δD_s D_m⁻¹):
 //   δP_t = δP_d,t + κ_t δē_c G_t + κ_t ē_c δG_t,   δē_c = Σ_s w_s (G_s : δF_s) / Λ_c,
 // gathered as K p = V_t δP_t D_m⁻ᵀ per vertex (the nodal forces' derivative, sign flipped).
+// That product is the reference; by default K is assembled once per linearisation instead
+// (fem_stiffness_assembly.h) and each product is a sparse multiply, unless the matrix would take more
+// than kAssembledBudgetBytes.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -20,6 +23,7 @@
 #include <stdexcept>
 
 #include "solve/fem_element.h"
+#include "solve/fem_stiffness_assembly.h"
 #include "solve/fem_tets.h"
 #include "solve/force_field.h"
 
@@ -27,9 +31,15 @@ namespace pneumo {
 
 namespace {
 
+// Above this the assembled K (3×3 blocks of every node pair in a cube: about 27 per node) is not
+// built and the product stays matrix-free: 1 GiB is about 14 M nodes' pairs, beyond any mesh the
+// presets make, and leaves the rest of a 16 GB machine to the CT.
+constexpr int64_t kAssembledBudgetBytes = int64_t(1) << 30;
+
 class FemForceField final : public ForceField {
  public:
-  explicit FemForceField(const Mesh& m, FemLaw law) : m_(m), law_(law), adj_(Adjacency::of(m)), tets_(m, law) {}
+  FemForceField(const Mesh& m, FemLaw law, FemStiffness stiffness)
+      : m_(m), law_(law), stiffness_(stiffness), adj_(Adjacency::of(m)), tets_(m, law) {}
 
   void evaluate(const ForceModel& model, const std::vector<Vec3>& x, const std::vector<Vec3>&,
                 std::vector<Vec3>& f) override {
@@ -72,9 +82,22 @@ class FemForceField final : public ForceField {
     return e;
   }
 
-  void linearize(const ForceModel& model, const std::vector<Vec3>& x) override { update_states(model, x); }
+  void linearize(const ForceModel& model, const std::vector<Vec3>& x) override {
+    update_states(model, x);
+    if (stiffness_ == FemStiffness::MatrixFree || assembled_current_) return;
+    if (!assembly_) {
+      if (FemStiffnessAssembly::bytes_upper_bound(m_, *groups_) > kAssembledBudgetBytes) {
+        stiffness_ = FemStiffness::MatrixFree;
+        return;
+      }
+      assembly_.emplace(m_, *groups_);
+    }
+    assembly_->assemble(m_, tets_, *groups_, state_, ebar_);
+    assembled_current_ = true;
+  }
 
   void stiffness_product(const std::vector<Vec3>& p, std::vector<Vec3>& kp) override {
+    if (stiffness_ == FemStiffness::Assembled && assembled_current_) return assembly_->multiply(p, kp);
     const int64_t T = int64_t(m_.tets.size()), N = m_.node_count();
     dF_.resize(T);
 #pragma omp parallel for schedule(static) if (T > 20000)
@@ -165,9 +188,11 @@ class FemForceField final : public ForceField {
   void update_states(const ForceModel& model, const std::vector<Vec3>& x) {
     if (!groups_ || groups_->by_cube != model.mean_dilatation) {
       groups_.emplace(m_, tets_, model.mean_dilatation);
+      assembly_.reset();
       states_x_.clear();
     }
     if (model.stiffening == states_stiffening_ && x == states_x_) return;
+    assembled_current_ = false;
     states_x_ = x;
     states_stiffening_ = model.stiffening;
     const int64_t T = int64_t(m_.tets.size());
@@ -203,9 +228,12 @@ class FemForceField final : public ForceField {
 
   const Mesh& m_;
   FemLaw law_;
+  FemStiffness stiffness_;
   Adjacency adj_;
   FemTets tets_;
   std::optional<FemGroups> groups_;   // built for the model's mean_dilatation
+  std::optional<FemStiffnessAssembly> assembly_;   // the pattern of groups_, once assembled
+  bool assembled_current_ = false;    // assembly_ holds K at states_x_
   std::vector<ElementState> state_;
   std::vector<double> ebar_, debar_;
   std::vector<Mat3> dF_;
@@ -217,8 +245,8 @@ class FemForceField final : public ForceField {
 
 }  // namespace
 
-std::unique_ptr<ForceField> make_fem_force_field(const Mesh& m, MaterialModel model) {
-  return std::make_unique<FemForceField>(m, fem_law_of(model));
+std::unique_ptr<ForceField> make_fem_force_field(const Mesh& m, MaterialModel model, FemStiffness stiffness) {
+  return std::make_unique<FemForceField>(m, fem_law_of(model), stiffness);
 }
 
 }  // namespace pneumo

@@ -53,8 +53,14 @@ class ForceField {
 /// and the wall-viscera bond when model.tie_interface.
 std::unique_ptr<ForceField> make_force_field(const Mesh& m, const ForceModel& model);
 
+/// How the finite elements multiply by their stiffness: assembled once per linearisation
+/// (fem_stiffness_assembly.h; the default) or matrix-free, evaluating each element's tangent per
+/// product (the reference, which the assembled product is tested against).
+enum class FemStiffness : uint8_t { Assembled, MatrixFree };
+
 /// The implementations (what make_force_field picks from).
 std::unique_ptr<ForceField> make_spring_force_field(const Mesh& m);
-std::unique_ptr<ForceField> make_fem_force_field(const Mesh& m, MaterialModel model);
+std::unique_ptr<ForceField> make_fem_force_field(const Mesh& m, MaterialModel model,
+                                                 FemStiffness stiffness = FemStiffness::Assembled);
 
 }  // namespace pneumo
