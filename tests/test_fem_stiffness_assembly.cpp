@@ -3,6 +3,7 @@
 // tests/test_fem.cpp checks against the forces' finite differences.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -10,11 +11,13 @@
 
 #include "mesh/mesh.h"
 #include "mesh_test_support.h"
-#include "solve/block_csr.h"
+#include "solve/symmetric_block_csr.h"
 #include "solve/force_field.h"
 
 namespace pneumo {
 namespace {
+
+constexpr uint32_t kSeedProduct = 20261206u;
 
 struct RandomState {
   Mesh mesh;
@@ -90,31 +93,60 @@ TEST(FemStiffnessAssembly, ProductEqualsTheMatrixFreeReference) {
   ::testing::Test::RecordProperty("worst_relative_difference", testing::PrintToString(worst_relative));
 }
 
-TEST(BlockCsr, PatternCouplesEveryPairWithinAGroupAndNothingElse) {
-  // Groups {0, 1, 2} and {2, 3} of 5 nodes: node 2 couples with 0–3; node 4 is in no group, so its
-  // row is empty and the product gives 0 there.
+TEST(SymmetricBlockCsr, PatternIsTheUpperTriangleOfEveryPairWithinAGroup) {
+  // Groups {0, 1, 2} and {2, 3} of 5 nodes: rows keep the columns at and above themselves; node 4
+  // is in no group, so its row is empty and the product gives 0 there.
   const std::vector<int64_t> begin = {0, 3, 5};
   const std::vector<int32_t> nodes = {0, 1, 2, 2, 3};
-  BlockCsr a = block_pattern_of_groups(5, begin, nodes);
-  const std::vector<std::vector<int32_t>> expected = {{0, 1, 2}, {0, 1, 2}, {0, 1, 2, 3}, {2, 3}, {}};
+  const SymmetricBlockCsr a = symmetric_pattern_of_groups(5, begin, nodes);
+  const std::vector<std::vector<int32_t>> expected = {{0, 1, 2}, {1, 2}, {2, 3}, {3}, {}};
   for (int32_t r = 0; r < 5; ++r) {
     const std::vector<int32_t> row(a.col.begin() + a.row_start[r], a.col.begin() + a.row_start[r + 1]);
     EXPECT_EQ(row, expected[r]) << "row " << r;
   }
   EXPECT_EQ(a.find(3, 0), -1);
+  EXPECT_EQ(a.find(0, 3), -1);
   EXPECT_EQ(a.col[a.find(2, 3)], 3);
-  // y = A x for a block (r, c) = (r + 1) I + c J (J all ones), against the sum written out.
-  for (int32_t r = 0; r < 5; ++r)
-    for (int64_t k = a.row_start[r]; k < a.row_start[r + 1]; ++k)
-      a.block[k] = double(r + 1) * Mat3::Identity() + double(a.col[k]) * Mat3::Ones();
-  std::vector<Vec3> x = {Vec3(1, 2, 3), Vec3(-1, 0, 1), Vec3(0.5, 0.5, 0.5), Vec3(2, -2, 0), Vec3(9, 9, 9)};
-  std::vector<Vec3> y;
-  a.multiply(x, y);
-  for (int32_t r = 0; r < 5; ++r) {
-    Vec3 want = Vec3::Zero();
-    for (int32_t c : expected[r]) want += double(r + 1) * x[c] + double(c) * Vec3::Constant(x[c].sum());
-    EXPECT_LT((y[r] - want).norm(), 1e-12) << "row " << r;
+}
+
+TEST(SymmetricBlockCsr, ProductIsTheFullSymmetricMatrixTimesTheVector) {
+  // 30,000 nodes (above the size at which the product runs on every thread), groups of 2–8 random
+  // nodes, random blocks: A x against the sum over the stored blocks and their transposes, written
+  // out. Tolerance 1e-12 of the largest |y|: the same terms summed in another order.
+  std::mt19937 rng(kSeedProduct);
+  std::uniform_int_distribution<int32_t> node(0, 29999), size(2, 8);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<int64_t> begin = {0};
+  std::vector<int32_t> nodes;
+  for (int g = 0; g < 20000; ++g) {
+    std::vector<int32_t> members;
+    for (int k = size(rng); k > 0; --k) members.push_back(node(rng));
+    std::sort(members.begin(), members.end());
+    members.erase(std::unique(members.begin(), members.end()), members.end());
+    nodes.insert(nodes.end(), members.begin(), members.end());
+    begin.push_back(int64_t(nodes.size()));
   }
+  SymmetricBlockCsr a = symmetric_pattern_of_groups(30000, begin, nodes);
+  for (Mat3& b : a.block)
+    for (int i = 0; i < 9; ++i) b(i / 3, i % 3) = u(rng);
+  for (int32_t r = 0; r < a.rows(); ++r)   // diagonal blocks symmetric, as a symmetric matrix's are
+    if (const int64_t k = a.find(r, r); k >= 0) a.block[k] = (a.block[k] + a.block[k].transpose()).eval();
+  std::vector<Vec3> x(30000), y, want(30000, Vec3::Zero());
+  for (Vec3& v : x) v = Vec3(u(rng), u(rng), u(rng));
+  a.multiply(x, y);
+  for (int32_t r = 0; r < a.rows(); ++r)
+    for (int64_t k = a.row_start[r]; k < a.row_start[r + 1]; ++k) {
+      const int32_t c = a.col[k];
+      want[r] += a.block[k] * x[c];
+      if (c != r) want[c] += a.block[k].transpose() * x[r];
+    }
+  double worst = 0.0;
+  for (int32_t r = 0; r < a.rows(); ++r) worst = std::max(worst, (y[r] - want[r]).norm());
+  EXPECT_LT(worst, 1e-12 * max_norm(want));
+  a.multiply(x, y);   // a second product starts its partial sums afresh
+  double again = 0.0;
+  for (int32_t r = 0; r < a.rows(); ++r) again = std::max(again, (y[r] - want[r]).norm());
+  EXPECT_LT(again, 1e-12 * max_norm(want));
 }
 
 }  // namespace

@@ -31,9 +31,9 @@ namespace pneumo {
 
 namespace {
 
-// Above this the assembled K (3×3 blocks of every node pair in a cube: about 27 per node) is not
-// built and the product stays matrix-free: 1 GiB is about 14 M nodes' pairs, beyond any mesh the
-// presets make, and leaves the rest of a 16 GB machine to the CT.
+// Above this the assembled K (3×3 blocks of the node pairs in a cube, upper triangle: about 14 per
+// node) is not built and the product stays matrix-free: 1 GiB is about 1 M nodes, beyond the meshes
+// the presets make, and leaves the rest of a 16 GB machine to the CT.
 constexpr int64_t kAssembledBudgetBytes = int64_t(1) << 30;
 
 class FemForceField final : public ForceField {

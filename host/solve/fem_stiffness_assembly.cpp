@@ -44,20 +44,21 @@ int64_t FemStiffnessAssembly::bytes_upper_bound(const Mesh& m, const FemGroups& 
   std::vector<int32_t> nodes;
   distinct_nodes_of_groups(m, groups, begin, nodes);
   int64_t blocks = 0;
-  for (std::size_t g = 0; g + 1 < begin.size(); ++g) blocks += (begin[g + 1] - begin[g]) * (begin[g + 1] - begin[g]);
+  for (std::size_t g = 0; g + 1 < begin.size(); ++g) blocks += (begin[g + 1] - begin[g]) * (begin[g + 1] - begin[g] + 1) / 2;
   return blocks * int64_t(sizeof(Mat3) + sizeof(int32_t));
 }
 
 FemStiffnessAssembly::FemStiffnessAssembly(const Mesh& m, const FemGroups& groups) {
   distinct_nodes_of_groups(m, groups, node_begin_, nodes_);
   const int64_t G = int64_t(node_begin_.size()) - 1;
-  k_ = block_pattern_of_groups(m.node_count(), node_begin_, nodes_);
+  k_ = symmetric_pattern_of_groups(m.node_count(), node_begin_, nodes_);
   slot_begin_.assign(1, 0);
   for (int64_t g = 0; g < G; ++g) {
     const int64_t n = node_begin_[g + 1] - node_begin_[g];
     if (n > kMaxGroupNodes) throw std::logic_error("FemStiffnessAssembly: a group with more than 64 nodes");
     for (int64_t a = 0; a < n; ++a)
-      for (int64_t b = 0; b < n; ++b) slot_.push_back(k_.find(nodes_[node_begin_[g] + a], nodes_[node_begin_[g] + b]));
+      for (int64_t b = 0; b < n; ++b)   // the nodes ascend, so a > b is below the diagonal
+        slot_.push_back(a > b ? -1 : k_.find(nodes_[node_begin_[g] + a], nodes_[node_begin_[g] + b]));
     slot_begin_.push_back(int64_t(slot_.size()));
   }
   local_.resize(4 * m.tets.size());
@@ -105,7 +106,8 @@ void FemStiffnessAssembly::assemble(const Mesh&, const FemTets& tets, const FemG
         for (int64_t a = 0; a < n; ++a)
           for (int64_t c = 0; c < n; ++c) out[a * n + c] += b_c[a] * b_c[c].transpose() / groups.weight[g];
     }
-    for (int64_t s = slot_begin_[g0]; s < slot_begin_[g1]; ++s) k_.block[slot_[s]] += local[s - slot_begin_[g0]];
+    for (int64_t s = slot_begin_[g0]; s < slot_begin_[g1]; ++s)
+      if (slot_[s] >= 0) k_.block[slot_[s]] += local[s - slot_begin_[g0]];
     g0 = g1;
   }
 }

@@ -12,12 +12,14 @@
 // their sum) and V_t its rest volume:
 //   the tetrahedron's own tangent, block (i, j) column b = V_t (δP_d + κ_t ē_c δG)(e_b ⊗ ∇N_j) ∇N_i;
 //   the cube's mean dilatation, rank one: b_c b_cᵀ / Λ_c, with b_c,i = Σ_t κ_t V_t G_t ∇N_i,
-// since δē_c = b_c · p / Λ_c and the term's forces are δē_c b_c.
+// since δē_c = b_c · p / Λ_c and the term's forces are δē_c b_c. K is symmetric (the Hessian of the
+// elastic energy; asymmetric to 1e-16 of its largest block as computed), so only its upper triangle
+// is kept.
 #include <cstdint>
 #include <vector>
 
 #include "mesh/mesh.h"
-#include "solve/block_csr.h"
+#include "solve/symmetric_block_csr.h"
 #include "solve/fem_element.h"
 #include "solve/fem_tets.h"
 
@@ -25,8 +27,8 @@ namespace pneumo {
 
 class FemStiffnessAssembly {
  public:
-  /// The blocks the pattern of `groups` would hold (Σ over groups of their distinct nodes squared,
-  /// an upper bound) times a block's bytes: what the assembled matrix would cost.
+  /// The blocks the pattern of `groups` would hold (Σ over groups of n_g (n_g + 1) / 2 for their
+  /// n_g distinct nodes, an upper bound) times a block's bytes: what the assembled matrix would cost.
   static int64_t bytes_upper_bound(const Mesh& m, const FemGroups& groups);
 
   FemStiffnessAssembly(const Mesh& m, const FemGroups& groups);
@@ -36,15 +38,15 @@ class FemStiffnessAssembly {
                 const std::vector<double>& ebar);
   /// kp = K p at the last assembly.
   void multiply(const std::vector<Vec3>& p, std::vector<Vec3>& kp) const { k_.multiply(p, kp); }
-  const BlockCsr& matrix() const { return k_; }
+  const SymmetricBlockCsr& matrix() const { return k_; }
 
  private:
   // Group g's distinct nodes are nodes_[node_begin_[g]] …; its local block (a, b) lands in
-  // k_.block[slot_[slot_begin_[g] + a n_g + b]]; vertex i of tetrahedron t is local node local_[4t + i].
+  // k_.block[slot_[slot_begin_[g] + a n_g + b]] (−1 below the diagonal); vertex i of tetrahedron t is local node local_[4t + i].
   std::vector<int64_t> node_begin_, slot_begin_, slot_;
   std::vector<int32_t> nodes_;
   std::vector<uint8_t> local_;
-  BlockCsr k_;
+  SymmetricBlockCsr k_;
 };
 
 }  // namespace pneumo
