@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", quiet, "Show errors only (no progress)");
   int threads = 0;
   CLI::Option* threads_option = app.add_option(
-      "--threads", threads, "CPU threads for pneumo's loops and PoCL's CPU device, 1 to 1024 (default: every core)");
+      "--threads", threads, "CPU threads for pneumo's loops and PoCL's CPU device, 1 to 1024 (default: at each stage, the cores other processes leave free)");
 
   std::vector<std::pair<CLI::App*, cli::Run>> commands;
   auto add = [&](cli::Run (*make)(CLI::App&)) {

@@ -2,22 +2,69 @@
 
 #include <omp.h>
 
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <thread>
 
 #include "core/error.h"
 #include "core/log.h"
 
 namespace pneumo {
 
+namespace {
+
+bool g_count_fixed = false;
+
+}  // namespace
+
 void set_thread_count(int threads) {
   if (threads < 1 || threads > kMaxThreads)
     throw InputError("--threads " + std::to_string(threads) + ": must be 1 to " + std::to_string(kMaxThreads));
   omp_set_num_threads(threads);
+  g_count_fixed = true;
   const std::string n = std::to_string(threads);
   setenv("POCL_MAX_PTHREAD_COUNT", n.c_str(), 1);  // PoCL up to 3.x (Debian 12 ships 3.1)
   setenv("POCL_CPU_MAX_CU_COUNT", n.c_str(), 1);   // PoCL 4 and later
   log::debug("CPU threads: " + n + " (OpenMP loops and PoCL's CPU device)");
+}
+
+int cores_left(int usable, std::vector<int> runnable_samples) {
+  usable = std::max(usable, 1);
+  if (runnable_samples.empty()) return usable;
+  std::nth_element(runnable_samples.begin(), runnable_samples.begin() + runnable_samples.size() / 2,
+                   runnable_samples.end());
+  const int others = std::max(runnable_samples[runnable_samples.size() / 2] - 1, 0);
+  return std::clamp(usable - others, 1, usable);
+}
+
+int runnable_tasks(const char* line) {
+  double l1, l5, l15;
+  int running = -1, total = 0;
+  if (std::sscanf(line, "%lf %lf %lf %d/%d", &l1, &l5, &l15, &running, &total) != 5) return -1;
+  return running;
+}
+
+void fit_threads_to_load() {
+  if (g_count_fixed || std::getenv("OMP_NUM_THREADS")) return;
+  const int usable = omp_get_num_procs();   // the CPUs of this process's affinity
+  std::vector<int> samples;
+  for (int i = 0; i < 5; ++i) {
+    if (i > 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    FILE* f = std::fopen("/proc/loadavg", "r");
+    if (!f) break;
+    char line[256] = {};
+    const bool read = std::fgets(line, sizeof line, f) != nullptr;
+    std::fclose(f);
+    const int n = read ? runnable_tasks(line) : -1;
+    if (n >= 0) samples.push_back(n);
+  }
+  const int threads = cores_left(usable, samples);
+  omp_set_num_threads(threads);
+  log::debug("CPU threads: " + std::to_string(threads) + " of " + std::to_string(usable) +
+             (threads < usable ? " (other processes keep the rest busy)" : ""));
 }
 
 }  // namespace pneumo

@@ -2,13 +2,35 @@
 // How many CPU threads pneumo uses: its own loops (OpenMP) and PoCL's CPU device, which runs the
 // OpenCL kernels on this machine. `--threads N` sets both, so a user who shares the machine (or
 // benchmarks one core) says it once.
+//
+// Without it, each stage starts on the cores that other processes leave free (fit_threads_to_load):
+// the solver's loops meet at a barrier every fraction of a millisecond, so a thread that shares its
+// core with a busy process holds the others up at each one, and two threads were 1.7 times slower
+// than one beside a busy process (docs/performance.md, "A busy machine").
+#include <vector>
+
 namespace pneumo {
 
 inline constexpr int kMaxThreads = 1024;
 
 /// Sets the count for OpenMP now and for PoCL's CPU device when it is first opened (PoCL reads
 /// POCL_MAX_PTHREAD_COUNT, and from 4.0 POCL_CPU_MAX_CU_COUNT, when it creates the device), so call
-/// it before any OpenCL platform is listed. InputError outside 1…kMaxThreads.
+/// it before any OpenCL platform is listed. InputError outside 1…kMaxThreads. The count then stays.
 void set_thread_count(int threads);
+
+/// The cores left to this process: `usable` (those it may run on) less the other tasks running now,
+/// from samples of the kernel's count of runnable tasks, each of which includes the sampling
+/// thread itself: usable − (median − 1), within [1, usable].
+int cores_left(int usable, std::vector<int> runnable_samples);
+
+/// The runnable tasks in a /proc/loadavg line ("0.50 0.60 0.70 3/512 1234": 3), or −1 if the line
+/// has no such field.
+int runnable_tasks(const char* loadavg_line);
+
+/// Unless the count is fixed (set_thread_count, or OMP_NUM_THREADS in the environment), OpenMP's
+/// loops use cores_left() of the cores this process may use, from five reads of /proc/loadavg 2 ms
+/// apart, until the next call. Called at the start of each stage; a stage's count does not follow a
+/// load that starts during it. PoCL's device keeps the count it was opened with.
+void fit_threads_to_load();
 
 }  // namespace pneumo

@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
+#include "core/thread_count.h"
 #include "image/png.h"
 #include "io/volume_io.h"
 #include "pipeline/exterior_views.h"
@@ -105,6 +106,7 @@ bool encode_mp4(const fs::path& frame_dir, const fs::path& mp4, double fps) {
 }
 
 RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
+  fit_threads_to_load();
   const ViewSettings& r = scene.render;
   RenderRun run;
   const fs::path out(opt.out_dir);

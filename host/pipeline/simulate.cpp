@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/units.h"
+#include "core/thread_count.h"
 #include "cl/cl_runtime.h"
 #include "mesh/deformation_file.h"
 #include "mesh/vtu_writer.h"
@@ -43,6 +44,7 @@ void throw_if_stopped_inverted(const SolveResult& r, const Mesh& m, double targe
 }  // namespace
 
 Simulation prepare_simulation(const Scene& scene) {
+  fit_threads_to_load();
   Simulation sim;
   auto t0 = std::chrono::steady_clock::now();
   sim.roles = load_roles(scene);
@@ -72,6 +74,7 @@ Simulation simulate_scene(const Scene& scene) {
 }
 
 void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hooks) {
+  fit_threads_to_load();
   const auto t0 = std::chrono::steady_clock::now();
   const ocl::DeviceSpec device = ocl::parse_device_spec(scene.device);
   std::shared_ptr<ocl::Context> ctx;

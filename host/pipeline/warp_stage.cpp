@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/units.h"
+#include "core/thread_count.h"
 #include "io/itk_transform_io.h"
 #include "io/volume_io.h"
 #include "image/png.h"
@@ -140,6 +141,7 @@ WarpedCase warp_scene(const Scene& scene, const std::string& sim_dir) {
 
 WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labels, RoleVolume roles, Mesh mesh,
                        Deformation deformation) {
+  fit_threads_to_load();
   WarpedCase w;
   w.label_names = scene_label_names(scene);
   w.ct = std::move(ct);
