@@ -22,6 +22,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "core/log.h"
 #include "solve/fem_element.h"
 #include "solve/fem_stiffness_assembly.h"
 #include "solve/fem_tets.h"
@@ -31,10 +32,11 @@ namespace pneumo {
 
 namespace {
 
-// Above this the assembled K (3×3 blocks of the node pairs in a cube, upper triangle: about 14 per
-// node) is not built and the product stays matrix-free: 1 GiB is about 1 M nodes, beyond the meshes
-// the presets make, and leaves the rest of a 16 GB machine to the CT.
-constexpr int64_t kAssembledBudgetBytes = int64_t(1) << 30;
+// Above this bound the assembled K is not built and the product stays matrix-free. The bound counts
+// each group's pairs apart (about 36 blocks per node where the upper triangle stores about 12), so
+// meshes up to about 750 k nodes are assembled, in at most about 0.7 GB: every preset's mesh, and the
+// 3 mm cubes of the convergence studies.
+constexpr int64_t kAssembledBudgetBytes = int64_t(2) << 30;
 
 class FemForceField final : public ForceField {
  public:
@@ -91,6 +93,10 @@ class FemForceField final : public ForceField {
         return;
       }
       assembly_.emplace(m_, *groups_);
+      const SymmetricBlockCsr& k = assembly_->matrix();
+      log::debug("finite elements: stiffness assembled as " + std::to_string(k.col.size()) + " blocks for " +
+                 std::to_string(m_.node_count()) + " nodes (" +
+                 std::to_string(k.col.size() * (sizeof(Mat3) + sizeof(int32_t)) >> 20) + " MiB)");
     }
     assembly_->assemble(m_, tets_, *groups_, state_, ebar_);
     assembled_current_ = true;

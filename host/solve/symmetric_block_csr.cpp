@@ -21,6 +21,7 @@ void SymmetricBlockCsr::multiply(const std::vector<Vec3>& x, std::vector<Vec3>& 
   // transposes, which land in other rows, into its own partial sums; the partial sums are added last.
 #pragma omp parallel num_threads(threads)
   {
+    const int team = omp_get_num_threads();   // at most `threads`: only these partial sums are fresh
     std::vector<Vec3>& mine = partial_[omp_get_thread_num()];
     mine.assign(R, Vec3::Zero());
 #pragma omp for schedule(static)
@@ -36,7 +37,7 @@ void SymmetricBlockCsr::multiply(const std::vector<Vec3>& x, std::vector<Vec3>& 
     }
 #pragma omp for schedule(static)
     for (int64_t r = 0; r < R; ++r)
-      for (int t = 0; t < threads; ++t) y[r] += partial_[t][r];
+      for (int t = 0; t < team; ++t) y[r] += partial_[t][r];
   }
 }
 
