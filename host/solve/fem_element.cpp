@@ -155,4 +155,10 @@ std::array<Vec3, 4> nodal_forces(const Mat3& P, const TetRest& rest) {
   return {Vec3(-(H.col(0) + H.col(1) + H.col(2))), Vec3(H.col(0)), Vec3(H.col(1)), Vec3(H.col(2))};
 }
 
+std::array<Vec3, 4> shape_gradients(const TetRest& rest) {
+  const Mat3& D = rest.dm_inverse;
+  return {Vec3(-(D.row(0) + D.row(1) + D.row(2)).transpose()), Vec3(D.row(0).transpose()), Vec3(D.row(1).transpose()),
+          Vec3(D.row(2).transpose())};
+}
+
 }  // namespace pneumo

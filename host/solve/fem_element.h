@@ -87,5 +87,8 @@ Mat3 edge_matrix(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3)
 /// The four nodal forces of stress P on a tetrahedron: vertices 1–3 the columns of −V₀ P D_m⁻ᵀ,
 /// vertex 0 minus their sum.
 std::array<Vec3, 4> nodal_forces(const Mat3& P, const TetRest& rest);
+/// ∇N_i of the four linear shape functions: the rows of D_m⁻¹ for vertices 1–3, vertex 0 minus their
+/// sum (so δF = Σ_i δx_i ⊗ ∇N_i).
+std::array<Vec3, 4> shape_gradients(const TetRest& rest);
 
 }  // namespace pneumo

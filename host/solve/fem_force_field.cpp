@@ -88,17 +88,17 @@ class FemForceField final : public ForceField {
     update_states(model, x);
     if (stiffness_ == FemStiffness::MatrixFree || assembled_current_) return;
     if (!assembly_) {
-      if (FemStiffnessAssembly::bytes_upper_bound(m_, *groups_) > kAssembledBudgetBytes) {
+      assembly_ = FemStiffnessAssembly::within(m_, *groups_, kAssembledBudgetBytes);
+      if (!assembly_) {
         stiffness_ = FemStiffness::MatrixFree;
         return;
       }
-      assembly_.emplace(m_, *groups_);
       const SymmetricBlockCsr& k = assembly_->matrix();
       log::debug("finite elements: stiffness assembled as " + std::to_string(k.col.size()) + " blocks for " +
                  std::to_string(m_.node_count()) + " nodes (" +
                  std::to_string(k.col.size() * (sizeof(Mat3) + sizeof(int32_t)) >> 20) + " MiB)");
     }
-    assembly_->assemble(m_, tets_, *groups_, state_, ebar_);
+    assembly_->assemble(tets_, *groups_, state_, ebar_);
     assembled_current_ = true;
   }
 
@@ -133,10 +133,8 @@ class FemForceField final : public ForceField {
     // dilatation (the cube coupling left out: this is only the preconditioner).
     blocks.assign(m_.node_count(), Mat3::Zero());
     for (std::size_t t = 0; t < m_.tets.size(); ++t) {
-      const Mat3& Dinv = tets_.rest[t].dm_inverse;
-      // ∂F/∂x_i along axis a is e_a ⊗ ∇N_i, with ∇N_i the rows of D_m⁻¹ (vertex 0: minus their sum).
-      const Vec3 grads[4] = {-(Dinv.row(0) + Dinv.row(1) + Dinv.row(2)).transpose(), Dinv.row(0).transpose(),
-                             Dinv.row(1).transpose(), Dinv.row(2).transpose()};
+      // ∂F/∂x_i along axis a is e_a ⊗ ∇N_i.
+      const std::array<Vec3, 4> grads = shape_gradients(tets_.rest[t]);
       for (int i = 0; i < 4; ++i)
         for (int a = 0; a < 3; ++a) {
           const Mat3 dF = Vec3::Unit(a) * grads[i].transpose();
@@ -156,9 +154,7 @@ class FemForceField final : public ForceField {
     const ElementState rest = element_state(law_, Mat3::Identity());
 #pragma omp parallel for schedule(static) if (T > 20000)
     for (int64_t t = 0; t < T; ++t) {
-      const Mat3& Dinv = tets_.rest[t].dm_inverse;
-      const Vec3 grads[4] = {-(Dinv.row(0) + Dinv.row(1) + Dinv.row(2)).transpose(), Dinv.row(0).transpose(),
-                             Dinv.row(1).transpose(), Dinv.row(2).transpose()};
+      const std::array<Vec3, 4> grads = shape_gradients(tets_.rest[t]);
       rows[t].fill(0.0);
       for (int j = 0; j < 4; ++j)
         for (int b = 0; b < 3; ++b) {

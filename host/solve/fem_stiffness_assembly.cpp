@@ -31,48 +31,42 @@ void distinct_nodes_of_groups(const Mesh& m, const FemGroups& groups, std::vecto
   }
 }
 
-std::array<Vec3, 4> shape_gradients(const TetRest& rest) {
-  const Mat3& D = rest.dm_inverse;
-  return {Vec3(-(D.row(0) + D.row(1) + D.row(2)).transpose()), Vec3(D.row(0).transpose()), Vec3(D.row(1).transpose()),
-          Vec3(D.row(2).transpose())};
-}
-
 }  // namespace
 
-int64_t FemStiffnessAssembly::bytes_upper_bound(const Mesh& m, const FemGroups& groups) {
-  std::vector<int64_t> begin;
-  std::vector<int32_t> nodes;
-  distinct_nodes_of_groups(m, groups, begin, nodes);
+std::optional<FemStiffnessAssembly> FemStiffnessAssembly::within(const Mesh& m, const FemGroups& groups,
+                                                                  int64_t budget_bytes) {
+  FemStiffnessAssembly a;
+  distinct_nodes_of_groups(m, groups, a.node_begin_, a.nodes_);
+  const int64_t G = int64_t(a.node_begin_.size()) - 1;
   int64_t blocks = 0;
-  for (std::size_t g = 0; g + 1 < begin.size(); ++g) blocks += (begin[g + 1] - begin[g]) * (begin[g + 1] - begin[g] + 1) / 2;
-  return blocks * int64_t(sizeof(Mat3) + sizeof(int32_t));
-}
-
-FemStiffnessAssembly::FemStiffnessAssembly(const Mesh& m, const FemGroups& groups) {
-  distinct_nodes_of_groups(m, groups, node_begin_, nodes_);
-  const int64_t G = int64_t(node_begin_.size()) - 1;
-  k_ = symmetric_pattern_of_groups(m.node_count(), node_begin_, nodes_);
-  slot_begin_.assign(1, 0);
   for (int64_t g = 0; g < G; ++g) {
-    const int64_t n = node_begin_[g + 1] - node_begin_[g];
+    const int64_t n = a.node_begin_[g + 1] - a.node_begin_[g];
     if (n > kMaxGroupNodes) throw std::logic_error("FemStiffnessAssembly: a group with more than 64 nodes");
-    for (int64_t a = 0; a < n; ++a)
-      for (int64_t b = 0; b < n; ++b)   // the nodes ascend, so a > b is below the diagonal
-        slot_.push_back(a > b ? -1 : k_.find(nodes_[node_begin_[g] + a], nodes_[node_begin_[g] + b]));
-    slot_begin_.push_back(int64_t(slot_.size()));
+    blocks += n * (n + 1) / 2;
   }
-  local_.resize(4 * m.tets.size());
+  if (blocks * int64_t(sizeof(Mat3) + sizeof(int32_t)) > budget_bytes) return std::nullopt;
+  a.k_ = symmetric_pattern_of_groups(m.node_count(), a.node_begin_, a.nodes_);
+  a.slot_begin_.assign(1, 0);
   for (int64_t g = 0; g < G; ++g) {
-    const auto first = nodes_.begin() + node_begin_[g], last = nodes_.begin() + node_begin_[g + 1];
+    const int64_t n = a.node_begin_[g + 1] - a.node_begin_[g];
+    for (int64_t r = 0; r < n; ++r)
+      for (int64_t c = 0; c < n; ++c)   // the nodes ascend, so r > c is below the diagonal
+        a.slot_.push_back(r > c ? -1 : a.k_.find(a.nodes_[a.node_begin_[g] + r], a.nodes_[a.node_begin_[g] + c]));
+    a.slot_begin_.push_back(int64_t(a.slot_.size()));
+  }
+  a.local_.resize(4 * m.tets.size());
+  for (int64_t g = 0; g < G; ++g) {
+    const auto first = a.nodes_.begin() + a.node_begin_[g], last = a.nodes_.begin() + a.node_begin_[g + 1];
     for (int32_t i = groups.begin[g]; i < groups.begin[g + 1]; ++i) {
       const int32_t t = groups.tets[i];
-      for (int v = 0; v < 4; ++v) local_[4 * t + v] = uint8_t(std::lower_bound(first, last, m.tets[t][v]) - first);
+      for (int v = 0; v < 4; ++v) a.local_[4 * t + v] = uint8_t(std::lower_bound(first, last, m.tets[t][v]) - first);
     }
   }
+  return a;
 }
 
-void FemStiffnessAssembly::assemble(const Mesh&, const FemTets& tets, const FemGroups& groups,
-                                    const std::vector<ElementState>& state, const std::vector<double>& ebar) {
+void FemStiffnessAssembly::assemble(const FemTets& tets, const FemGroups& groups, const std::vector<ElementState>& state,
+                                    const std::vector<double>& ebar) {
   for (Mat3& b : k_.block) b.setZero();
   const int64_t G = int64_t(node_begin_.size()) - 1;
   std::vector<Mat3> local;

@@ -16,6 +16,7 @@
 // elastic energy; asymmetric to 1e-16 of its largest block as computed), so only its upper triangle
 // is kept.
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "mesh/mesh.h"
@@ -27,22 +28,22 @@ namespace pneumo {
 
 class FemStiffnessAssembly {
  public:
-  /// The blocks the pattern of `groups` would hold (Σ over groups of n_g (n_g + 1) / 2 for their
-  /// n_g distinct nodes, an upper bound) times a block's bytes: what the assembled matrix would cost.
-  static int64_t bytes_upper_bound(const Mesh& m, const FemGroups& groups);
-
-  FemStiffnessAssembly(const Mesh& m, const FemGroups& groups);
+  /// The assembly for `groups`, or nothing when its blocks could exceed `budget_bytes`: the bound
+  /// counts each group's n_g (n_g + 1) / 2 pairs apart, so it overestimates the shared ones.
+  static std::optional<FemStiffnessAssembly> within(const Mesh& m, const FemGroups& groups, int64_t budget_bytes);
 
   /// K at the element states `state` and the groups' mean dilatations `ebar`.
-  void assemble(const Mesh& m, const FemTets& tets, const FemGroups& groups, const std::vector<ElementState>& state,
+  void assemble(const FemTets& tets, const FemGroups& groups, const std::vector<ElementState>& state,
                 const std::vector<double>& ebar);
   /// kp = K p at the last assembly.
   void multiply(const std::vector<Vec3>& p, std::vector<Vec3>& kp) const { k_.multiply(p, kp); }
   const SymmetricBlockCsr& matrix() const { return k_; }
 
  private:
+  FemStiffnessAssembly() = default;
   // Group g's distinct nodes are nodes_[node_begin_[g]] …; its local block (a, b) lands in
-  // k_.block[slot_[slot_begin_[g] + a n_g + b]] (−1 below the diagonal); vertex i of tetrahedron t is local node local_[4t + i].
+  // k_.block[slot_[slot_begin_[g] + a n_g + b]] (−1 below the diagonal); vertex i of tetrahedron t is
+  // local node local_[4t + i].
   std::vector<int64_t> node_begin_, slot_begin_, slot_;
   std::vector<int32_t> nodes_;
   std::vector<uint8_t> local_;
