@@ -106,7 +106,6 @@ bool encode_mp4(const fs::path& frame_dir, const fs::path& mp4, double fps) {
 }
 
 RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
-  fit_threads_to_load();
   const ViewSettings& r = scene.render;
   RenderRun run;
   const fs::path out(opt.out_dir);
@@ -144,6 +143,7 @@ RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
 
 RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Volume& ct, const Volume* labels,
                          RenderRun run) {
+  fit_threads_to_load();
   const auto start = std::chrono::steady_clock::now();
   const ViewSettings& r = scene.render;
   const fs::path out(opt.out_dir);
