@@ -47,7 +47,10 @@ struct GlRayCaster::Impl {
   std::map<std::string, std::unique_ptr<gl::ShaderProgram>> programs;  // by variant (#defines)
   GLuint vao = 0, fbo = 0, colour_tex = 0, depth_tex = 0;
   GLuint hu_tex = 0, grad_tex = 0, label_tex = 0, occ_tex = 0, tf_tex = 0, label_colour_tex = 0;
-  const RenderVolume* volume = nullptr;                    // set_volume's: it outlives the renders
+  // The labels on the views' grid: set_volume's volume's own (it outlives the renders), or, where
+  // the views' grid is coarser (view_grid_stride), the copy kept here.
+  const std::vector<uint16_t>* labels = nullptr;
+  std::vector<uint16_t> resampled_labels;
   std::optional<std::vector<std::array<uint8_t, 4>>> colours_uploaded;   // none: no colour volume yet
   bool packed = false;  // hu_tex holds (HU, gradient); grad_tex unused
   int fb_width = 0, fb_height = 0;
@@ -118,11 +121,11 @@ struct GlRayCaster::Impl {
     if (label_colour_tex) g.DeleteTextures(1, &label_colour_tex);
     label_colour_tex = make_texture(GL_TEXTURE_3D, GL_LINEAR);
     g.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    if (volume->labels.empty()) {
+    if (labels->empty()) {
       const uint8_t zero[4] = {0, 0, 0, 0};
       g.TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8, 1, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, zero);
     } else {
-      const std::vector<uint8_t> rgba = label_colour_volume(*volume, c);
+      const std::vector<uint8_t> rgba = label_colour_volume(*labels, c);
       const auto& d = geometry.dims;
       g.TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA8, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RGBA,
                    GL_UNSIGNED_BYTE, rgba.data());
@@ -155,7 +158,9 @@ void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
   Impl& m = *impl_;
   m.ctx.make_current();
   const gl::Api& g = gl::api();
-  const auto& d = v.geometry.dims;
+  std::optional<RenderVolume> smoothed;
+  const RenderVolume& viewed = volume_as_viewed(v, smoothed, /*with_labels=*/false);
+  const auto& d = viewed.geometry.dims;
   const int max3d = m.ctx.info().max_3d_texture_size;
   for (int a = 0; a < 3; ++a)
     if (d[a] > max3d)
@@ -168,8 +173,6 @@ void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
   m.hu_tex = make_texture(GL_TEXTURE_3D, GL_LINEAR);
   // SNORM maps s to s/32767 exactly for s in ±32767 and filters in floating point.
   m.packed = v.hu_is_int16 && !force_float;
-  std::optional<RenderVolume> smoothed;
-  const RenderVolume& viewed = volume_as_viewed(v, smoothed, /*with_labels=*/false);
   const std::vector<int16_t> grad = voxel_gradients(viewed, m.packed);
   if (m.packed) {  // (HU, gx, gy, gz): one fetch per shaded sample
     g.TexImage3D(GL_TEXTURE_3D, 0, GL_RGBA16_SNORM, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RGBA,
@@ -188,23 +191,31 @@ void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
   gl::check_error("CT upload");
   if (m.label_tex) g.DeleteTextures(1, &m.label_tex);
   m.label_tex = make_texture(GL_TEXTURE_3D, GL_NEAREST);
-  if (!v.labels.empty()) {
+  // On a coarser grid volume_as_viewed resampled the labels; on the CT's it left them in v.
+  const bool resampled = smoothed && !smoothed->labels.empty();   // asked without labels: only then
+  m.resampled_labels = resampled ? std::move(smoothed->labels) : std::vector<uint16_t>{};
+  m.labels = resampled ? &m.resampled_labels : &v.labels;
+  if (!m.labels->empty()) {
     g.TexImage3D(GL_TEXTURE_3D, 0, GL_R16UI, GLsizei(d[0]), GLsizei(d[1]), GLsizei(d[2]), 0, GL_RED_INTEGER,
-                 GL_UNSIGNED_SHORT, v.labels.data());
+                 GL_UNSIGNED_SHORT, m.labels->data());
   } else {
     const uint16_t zero = 0;
     g.TexImage3D(GL_TEXTURE_3D, 0, GL_R16UI, 1, 1, 1, 0, GL_RED_INTEGER, GL_UNSIGNED_SHORT, &zero);
   }
   gl::check_error("label upload");
-  m.geometry = v.geometry;
-  m.w2i = v.world_to_index();
-  m.ranges = block_ranges(viewed, v.labels);
+  m.geometry = viewed.geometry;
+  m.w2i = viewed.world_to_index();
+  m.ranges = block_ranges(viewed, *m.labels);
   m.occ_key.reset();
-  m.volume = &v;
   m.colours_uploaded.reset();
   m.have_volume = true;
   log::debug("GL ray caster: volume " + std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" +
-             std::to_string(d[2]) + " as " + m.hu_format);
+             std::to_string(d[2]) + " as " + m.hu_format +
+             (&viewed != &v && d != v.geometry.dims ? " (the views' grid, coarser than the CT's " +
+                                                          std::to_string(v.geometry.dims[0]) + "x" +
+                                                          std::to_string(v.geometry.dims[1]) + "x" +
+                                                          std::to_string(v.geometry.dims[2]) + ")"
+                                                    : std::string()));
 }
 
 std::vector<int16_t> GlRayCaster::read_gradient_texture() {

@@ -90,14 +90,20 @@ inline void weighted_rows(float* out, const std::vector<const float*>& rows, con
   }
 }
 
-// The three passes of smooth_for_views from `src` into `a` (with `b` as scratch), each laid out so
-// that its inner loop runs along contiguous memory: along i a padded copy of the row, along j and k
-// whole rows weighted and summed (k innermost per j, so the rows a tap reuses stay in cache).
-void gaussian_filter(const float* src, float* a, float* b, const Index3& d, const Vec3& sigma) {
+// The three passes of the views' prefilter, each laid out so that its inner loop runs along
+// contiguous memory: along i a padded copy of the row, along j and k whole rows weighted and summed
+// (k innermost per j, so the rows a tap reuses stay in cache). Each pass keeps only every
+// stride[a]-th output along its axis, so a decimated result costs a fraction of a full one: with
+// stride 2 the passes write n/2, n/4 and n/8 values instead of 3n. Every kept value is summed in
+// the same order as with stride 1 (and -ffp-contract=off forbids fused multiply-adds), so it equals
+// the full-resolution result at that voxel bit for bit.
+std::vector<float> gaussian_filter(const float* src, const Index3& d, const Vec3& sigma, const Index3& stride) {
   const int64_t nx = d[0], ny = d[1], nz = d[2];
-  {  // along i: src → b
+  const int64_t mx = (nx - 1) / stride[0] + 1, my = (ny - 1) / stride[1] + 1, mz = (nz - 1) / stride[2] + 1;
+  std::vector<float> along_i(std::size_t(mx * ny * nz));
+  {  // along i: src → along_i (mx per row)
     const std::vector<float> w = gaussian_taps(sigma[0]);
-    const int64_t R = int64_t(w.size() / 2);
+    const int64_t R = int64_t(w.size() / 2), f = stride[0];
 #pragma omp parallel
     {
       std::vector<float> line(std::size_t(nx + 2 * R));
@@ -106,41 +112,57 @@ void gaussian_filter(const float* src, float* a, float* b, const Index3& d, cons
       for (int64_t q = 0; q < ny * nz; ++q) {
         const float* in = src + q * nx;
         for (int64_t t = -R; t < nx + R; ++t) line[std::size_t(t + R)] = in[std::clamp<int64_t>(t, 0, nx - 1)];
-        for (std::size_t r = 0; r < w.size(); ++r) rows[r] = line.data() + r;
-        weighted_rows(b + q * nx, rows, w, nx);
+        float* out = along_i.data() + q * mx;
+        if (f == 1) {
+          for (std::size_t r = 0; r < w.size(); ++r) rows[r] = line.data() + r;
+          weighted_rows(out, rows, w, nx);
+        } else {
+          for (int64_t i = 0; i < mx; ++i) {
+            const float* x = line.data() + f * i;
+            float sum = 0.0f;
+            for (std::size_t r = 0; r < w.size(); ++r) sum += w[r] * x[r];
+            out[i] = sum;
+          }
+        }
       }
     }
   }
-  {  // along j: b → a
+  std::vector<float> along_j(std::size_t(mx * my * nz));
+  {  // along j: along_i → along_j (rows of mx, my per slice)
     const std::vector<float> w = gaussian_taps(sigma[1]);
-    const int64_t R = int64_t(w.size() / 2);
+    const int64_t R = int64_t(w.size() / 2), f = stride[1];
 #pragma omp parallel
     {
       std::vector<const float*> rows(w.size());
 #pragma omp for schedule(static)
-      for (int64_t q = 0; q < ny * nz; ++q) {
-        const int64_t j = q % ny, k = q / ny;
+      for (int64_t q = 0; q < my * nz; ++q) {
+        const int64_t j = (q % my) * f, k = q / my;
         for (int64_t r = 0; r < int64_t(w.size()); ++r)
-          rows[std::size_t(r)] = b + (k * ny + std::clamp<int64_t>(j + r - R, 0, ny - 1)) * nx;
-        weighted_rows(a + q * nx, rows, w, nx);
+          rows[std::size_t(r)] = along_i.data() + (k * ny + std::clamp<int64_t>(j + r - R, 0, ny - 1)) * mx;
+        weighted_rows(along_j.data() + q * mx, rows, w, mx);
       }
     }
   }
-  {  // along k: a → b, then b → a by a copy-free swap of roles at the caller
+  // along k: along_j → the result; at stride 1 into along_i's memory, which no one reads any more.
+  std::vector<float> result;
+  if (stride[0] == 1 && stride[1] == 1 && stride[2] == 1) result.swap(along_i);
+  else result.resize(std::size_t(mx * my * mz));
+  {
     const std::vector<float> w = gaussian_taps(sigma[2]);
-    const int64_t R = int64_t(w.size() / 2);
+    const int64_t R = int64_t(w.size() / 2), f = stride[2];
 #pragma omp parallel
     {
       std::vector<const float*> rows(w.size());
 #pragma omp for schedule(static)
-      for (int64_t j = 0; j < ny; ++j)
-        for (int64_t k = 0; k < nz; ++k) {
+      for (int64_t j = 0; j < my; ++j)
+        for (int64_t k = 0; k < mz; ++k) {
           for (int64_t r = 0; r < int64_t(w.size()); ++r)
-            rows[std::size_t(r)] = a + (std::clamp<int64_t>(k + r - R, 0, nz - 1) * ny + j) * nx;
-          weighted_rows(b + (k * ny + j) * nx, rows, w, nx);
+            rows[std::size_t(r)] = along_j.data() + (std::clamp<int64_t>(f * k + r - R, 0, nz - 1) * my + j) * mx;
+          weighted_rows(result.data() + (k * my + j) * mx, rows, w, mx);
         }
     }
   }
+  return result;
 }
 
 // Whole HU, as a 16-bit texture holds them (hu_is_int16).
@@ -155,23 +177,49 @@ void round_to_int16_hu(std::vector<float>& hu) {
 
 void smooth_for_views(RenderVolume& v, const Vec3& sigma_voxels) {
   if (!(sigma_voxels.minCoeff() > 0.0) || v.hu.empty()) return;
-  std::vector<float> a(v.hu.size()), b(v.hu.size());
-  gaussian_filter(v.hu.data(), a.data(), b.data(), v.geometry.dims, sigma_voxels);
-  v.hu.swap(b);   // the last pass wrote b
+  v.hu = gaussian_filter(v.hu.data(), v.geometry.dims, sigma_voxels, Index3{1, 1, 1});
   if (v.hu_is_int16) round_to_int16_hu(v.hu);
+}
+
+Index3 view_grid_stride(const Geometry& g, double smoothing_mm) {
+  const Vec3 sigma = view_smoothing_sigma_voxels(g, smoothing_mm);
+  Index3 f{1, 1, 1};
+  for (int a = 0; a < 3; ++a) f[a] = std::max<int64_t>(1, int64_t(std::floor(sigma[a] + 1e-9)));
+  return f;
+}
+
+Geometry view_grid(const Geometry& g, const Index3& stride) {
+  Geometry c = g;
+  for (int a = 0; a < 3; ++a) {
+    c.dims[a] = (g.dims[a] - 1) / stride[a] + 1;
+    c.spacing_mm[a] = g.spacing_mm[a] * double(stride[a]);
+  }
+  return c;   // voxel (0,0,0) stays where it was: origin and direction unchanged
 }
 
 const RenderVolume& volume_as_viewed(const RenderVolume& v, std::optional<RenderVolume>& storage, bool with_labels) {
   if (!(v.smoothing_mm > 0.0)) return v;
+  const Index3 stride = v.views_on_ct_grid ? Index3{1, 1, 1} : view_grid_stride(v.geometry, v.smoothing_mm);
+  const bool resampled = stride != Index3{1, 1, 1};
   storage.emplace();
-  storage->geometry = v.geometry;
+  storage->geometry = view_grid(v.geometry, stride);
   storage->hu_is_int16 = v.hu_is_int16;
-  if (with_labels) storage->labels = v.labels;
-  const Vec3 sigma = view_smoothing_sigma_voxels(v.geometry, v.smoothing_mm);
-  std::vector<float> scratch(v.hu.size());
-  storage->hu.resize(v.hu.size());
-  gaussian_filter(v.hu.data(), scratch.data(), storage->hu.data(), v.geometry.dims, sigma);
+  storage->views_on_ct_grid = v.views_on_ct_grid;
+  storage->hu = gaussian_filter(v.hu.data(), v.geometry.dims, view_smoothing_sigma_voxels(v.geometry, v.smoothing_mm),
+                                stride);
   if (v.hu_is_int16) round_to_int16_hu(storage->hu);
+  if (resampled && !v.labels.empty()) {  // the label at each kept voxel: nearest, as the casters sample them
+    const Index3& d = storage->geometry.dims;
+    storage->labels.resize(std::size_t(storage->geometry.voxel_count()));
+#pragma omp parallel for schedule(static)
+    for (int64_t k = 0; k < d[2]; ++k)
+      for (int64_t j = 0; j < d[1]; ++j)
+        for (int64_t i = 0; i < d[0]; ++i)
+          storage->labels[std::size_t(storage->geometry.linear_index(i, j, k))] =
+              v.labels[std::size_t(v.geometry.linear_index(stride[0] * i, stride[1] * j, stride[2] * k))];
+  } else if (with_labels) {
+    storage->labels = v.labels;
+  }
   return *storage;
 }
 
@@ -227,12 +275,16 @@ LabelColours default_label_colours() {
 }
 
 std::vector<uint8_t> label_colour_volume(const RenderVolume& v, const LabelColours& c) {
-  std::vector<uint8_t> out(std::size_t(v.geometry.voxel_count()) * 4, 0);
-  if (v.labels.empty()) return out;
-  const int64_t n = v.geometry.voxel_count();
+  if (v.labels.empty()) return std::vector<uint8_t>(std::size_t(v.geometry.voxel_count()) * 4, 0);
+  return label_colour_volume(v.labels, c);
+}
+
+std::vector<uint8_t> label_colour_volume(const std::vector<uint16_t>& labels, const LabelColours& c) {
+  std::vector<uint8_t> out(labels.size() * 4, 0);
+  const int64_t n = int64_t(labels.size());
 #pragma omp parallel for schedule(static)
   for (int64_t i = 0; i < n; ++i) {
-    const auto p = premultiplied_colour(c, v.labels[std::size_t(i)]);
+    const auto p = premultiplied_colour(c, labels[std::size_t(i)]);
     std::copy(p.begin(), p.end(), out.begin() + 4 * i);
   }
   return out;

@@ -27,6 +27,9 @@ struct RenderVolume {
   /// itself stays exact, so whatever reads it for measurement (the page's slices, the port ranking)
   /// sees the CT, not the views' copy.
   double smoothing_mm = 0.0;
+  /// The views sample the smoothed CT on the CT's own grid even where the smoothing allows a coarser
+  /// one (view_grid_stride): the full-cost reference the coarser grid is measured against.
+  bool views_on_ct_grid = false;
 
   /// From a CT (any voxel type) and an optional label map; InputError when the label map's grid
   /// differs from the CT's or its ids do not fit 16 bits.
@@ -67,9 +70,24 @@ void smooth_for_views(RenderVolume& v, const Vec3& sigma_voxels);
 /// render.smoothing_mm = 0 shows the voxels as they are.
 Vec3 view_smoothing_sigma_voxels(const Geometry& g, double smoothing_mm);
 
+/// The views' grid (issue 19: a fine CT's views cost what a coarse one's do). Where the prefilter's
+/// σ spans f ≥ 2 voxels on an axis, the smoothed CT is sampled at every f-th voxel along it:
+/// f = ⌊σ/voxel⌋, so the new spacing f·h ≤ σ. A Gaussian of σ keeps exp(−2π²σ²ν²) of frequency ν,
+/// at the coarse grid's Nyquist ν = 1/(2fh) at most exp(−π²/2) = 0.7 %: the samples alias less than
+/// that, and trilinear interpolation between them moves a smoothed edge by under a tenth of σ
+/// (docs/rendering.md). At the default 1.5 mm a 0.75 mm CT is viewed on a 1.5 mm grid, an eighth
+/// of its voxels to filter, differentiate and upload; CTs of 1 mm and coarser keep their grid.
+/// {1, 1, 1} when smoothing_mm ≤ 0.
+Index3 view_grid_stride(const Geometry& g, double smoothing_mm);
+/// `g` with every stride[a]-th voxel along axis a: voxel (0,0,0), the origin and the direction
+/// stay; the box of voxel centres loses at most stride − 1 voxels at its upper ends.
+Geometry view_grid(const Geometry& g, const Index3& stride);
+
 /// The volume as the ray casters sample it: `v` itself when v.smoothing_mm ≤ 0, else a copy in
-/// `storage` filtered by smooth_for_views, its labels copied when `with_labels`. Filtered straight
-/// from v.hu: one copy's worth of memory beside the result, not two.
+/// `storage` filtered by smooth_for_views and sampled on view_grid(view_grid_stride) (the CT's own
+/// grid when v.views_on_ct_grid). Its labels: on a coarser grid the label at each kept voxel,
+/// always; on the CT's grid a copy of v's when `with_labels`, else none (the caller reads v's).
+/// Filtered straight from v.hu, each pass keeping only the voxels the next one reads.
 const RenderVolume& volume_as_viewed(const RenderVolume& v, std::optional<RenderVolume>& storage,
                                      bool with_labels = true);
 
@@ -120,6 +138,8 @@ inline std::array<uint8_t, 4> premultiplied_colour(const LabelColours& c, uint16
 /// premultiplied_colour() of every voxel's label, 4 bytes per voxel (i fastest); all zero without
 /// labels. OpenMP over slices.
 std::vector<uint8_t> label_colour_volume(const RenderVolume& v, const LabelColours& c);
+/// The same for a label map on its own.
+std::vector<uint8_t> label_colour_volume(const std::vector<uint16_t>& labels, const LabelColours& c);
 
 /// Empty-space skipping: block (bx, by, bz) covers voxel centres [b·B, (b+1)·B] on each axis
 /// (B = kOccupancyBlock; the upper face is shared with the next block, so every sample position's

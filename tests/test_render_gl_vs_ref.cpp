@@ -18,6 +18,7 @@
 #include "render/image_out.h"
 #include "render/ray_cast_gl.h"
 #include "render/ray_cast_ref.h"
+#include "render/view_settings.h"
 #include "render_test_support.h"
 #include "scene/scene.h"
 
@@ -141,6 +142,41 @@ TEST_P(RenderGlVsRef, ImagesAgreeByPsnrAndAreNotBlank) {
 
 INSTANTIATE_TEST_SUITE_P(Cases, RenderGlVsRef, ::testing::ValuesIn(cases()),
                          [](const ::testing::TestParamInfo<Case>& i) { return std::string(i.param.name); });
+
+// A CT finer than the smoothing is viewed on a coarser grid (render_volume.h view_grid_stride): at
+// 0.75 mm and the default 1.5 mm, every second voxel. The Gaussian keeps at most exp(−π²/2) = 0.7 %
+// at that grid's Nyquist frequency, and trilinear interpolation between its samples moves a
+// smoothed edge by under σ/10 = 0.15 mm, a fiftieth of a pixel here. So the views agree with those
+// sampled on the CT's own grid to the threshold that separates a right image from a wrong one
+// above (35 dB; a one-pixel shift is ~25 dB), and by SSIM ≥ 0.97, the agreement measured on the
+// large phantom's views (bench/results/2026-12-06-views-grid.md: 0.973–0.995).
+TEST(RenderViewsGrid, AFineCtViewedOnTheCoarserGridAgreesWithItsOwnGrid) {
+  PNEUMO_REQUIRE_GL(ctx);
+  CavityPhantom p;
+  p.spacing_mm = 0.75;
+  p.n = 128;   // the same 96 mm box as the 1.5 mm phantom
+  RenderVolume fine = make_cavity_phantom(p);
+  fine.smoothing_mm = kDefaultSmoothingMm;
+  RenderVolume own = fine;
+  own.views_on_ct_grid = true;
+  ASSERT_EQ(view_grid_stride(fine.geometry, fine.smoothing_mm), (Index3{2, 2, 2}));
+  RenderSettings s;
+  s.tf = preset_transfer_function(RenderPreset::Laparoscopic);
+  s.step_mm = 0.5 * p.spacing_mm;
+  for (const auto& [tip, look] : {std::pair{Vec3(0, 20, 0), Vec3(0, -35, 0)}, std::pair{Vec3(10, 0, 15), Vec3(-30, -5, -10)}}) {
+    const ViewCamera cam = make_view_camera(look_at_pose(tip, look, Vec3(0, 0, 1)), Optics{}, kSize, kSize);
+    GlRayCaster gl(*ctx);
+    gl.set_volume(fine);
+    const RenderImage coarse_grid = gl.render(cam, s);
+    gl.set_volume(own);
+    const RenderImage ct_grid = gl.render(cam, s);
+    const double psnr = psnr_db(coarse_grid, ct_grid), similarity = ssim(coarse_grid, ct_grid);
+    EXPECT_GE(psnr, 35.0);
+    EXPECT_GE(similarity, 0.97);
+    EXPECT_GT(image_stats(coarse_grid).mean_rgb, 0.03);
+    std::printf("[ views grid ] PSNR %.1f dB, SSIM %.4f\n", psnr, similarity);
+  }
+}
 
 // Pixels where the labelled organ shows: where the image with label colours differs from the one
 // without. Returns their count and mean pixel position.

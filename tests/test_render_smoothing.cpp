@@ -137,6 +137,72 @@ TEST(RenderSmoothing, NormalsOfAStaircasePlaneFollowThePlane) {
   EXPECT_LT(smooth, raw / 2.0);
 }
 
+// The views' grid: every f-th voxel where σ spans f voxels, f = ⌊σ/voxel⌋, so that the new spacing
+// never exceeds σ (render_volume.h: the Gaussian then keeps at most 0.7 % at the coarse Nyquist).
+TEST(RenderSmoothing, ViewsGridStrideIsTheWholeVoxelsTheSigmaSpans) {
+  Geometry g;
+  auto stride = [&](Vec3 spacing, double smoothing_mm) {
+    g.spacing_mm = spacing;
+    return view_grid_stride(g, smoothing_mm);
+  };
+  EXPECT_EQ(stride(Vec3(0.75, 0.75, 0.75), 1.5), (Index3{2, 2, 2}));
+  EXPECT_EQ(stride(Vec3(0.5, 0.5, 0.5), 1.5), (Index3{3, 3, 3}));
+  EXPECT_EQ(stride(Vec3(0.7, 0.7, 3.0), 1.5), (Index3{2, 2, 1}));   // thick slices keep theirs
+  EXPECT_EQ(stride(Vec3(1.0, 1.0, 1.0), 1.5), (Index3{1, 1, 1}));   // σ of 1.5 voxels: no whole second
+  EXPECT_EQ(stride(Vec3(1.5, 1.5, 1.5), 1.5), (Index3{1, 1, 1}));
+  EXPECT_EQ(stride(Vec3(3.0, 3.0, 3.0), 1.5), (Index3{1, 1, 1}));
+  EXPECT_EQ(stride(Vec3(0.75, 0.75, 0.75), 0.0), (Index3{1, 1, 1}));   // no smoothing: the voxels
+  for (int a = 0; a < 3; ++a) {  // the bound itself: f·h ≤ σ on every axis
+    const Index3 f = stride(Vec3(0.3, 0.45, 0.7), 1.5);
+    EXPECT_LE(double(f[a]) * g.spacing_mm[a], 1.5 + 1e-9);
+    EXPECT_GT(double(f[a] + 1) * g.spacing_mm[a], 1.5);
+  }
+}
+
+// On the coarser grid every kept voxel holds what the CT-grid filter gives there, bit for bit (the
+// passes sum in the same order), its label is the voxel's own, and it sits at the same world point.
+TEST(RenderSmoothing, TheViewsGridKeepsTheFullFilterAtEveryKeptVoxel) {
+  RenderVolume v = grid_volume({23, 18, 14});
+  v.geometry.spacing_mm = Vec3(0.5, 0.75, 0.6);   // strides 3, 2, 2 at 1.5 mm
+  v.geometry.origin_mm = Vec3(-4.0, 7.5, 100.0);
+  v.geometry.direction = Eigen::AngleAxisd(0.3, Vec3(1, 1, 2).normalized()).toRotationMatrix();
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> hu(-1000, 1500), id(0, 9);
+  v.hu_is_int16 = true;
+  v.labels.resize(v.hu.size());
+  for (std::size_t n = 0; n < v.hu.size(); ++n) v.hu[n] = float(hu(rng)), v.labels[n] = uint16_t(id(rng));
+  v.smoothing_mm = 1.5;
+  const Index3 f = view_grid_stride(v.geometry, v.smoothing_mm);
+  ASSERT_EQ(f, (Index3{3, 2, 2}));
+
+  std::optional<RenderVolume> coarse_storage, full_storage;
+  const RenderVolume& coarse = volume_as_viewed(v, coarse_storage, /*with_labels=*/false);
+  RenderVolume on_ct_grid = v;
+  on_ct_grid.views_on_ct_grid = true;
+  const RenderVolume& full = volume_as_viewed(on_ct_grid, full_storage);
+  ASSERT_EQ(full.geometry.dims, v.geometry.dims);
+  ASSERT_EQ(coarse.geometry.dims, (Index3{8, 9, 7}));   // (n − 1)/f + 1
+  ASSERT_EQ(coarse.labels.size(), coarse.hu.size());    // resampled even when not asked for
+  for (int64_t k = 0; k < coarse.geometry.dims[2]; ++k)
+    for (int64_t j = 0; j < coarse.geometry.dims[1]; ++j)
+      for (int64_t i = 0; i < coarse.geometry.dims[0]; ++i) {
+        const int64_t c = coarse.geometry.linear_index(i, j, k);
+        const int64_t n = v.geometry.linear_index(f[0] * i, f[1] * j, f[2] * k);
+        ASSERT_EQ(coarse.hu[std::size_t(c)], full.hu[std::size_t(n)]) << i << " " << j << " " << k;
+        ASSERT_EQ(coarse.labels[std::size_t(c)], v.labels[std::size_t(n)]);
+        const Vec3 wc = coarse.geometry.to_world(Vec3(double(i), double(j), double(k)));
+        const Vec3 wf = v.geometry.to_world(Vec3(double(f[0] * i), double(f[1] * j), double(f[2] * k)));
+        ASSERT_LT((wc - wf).norm(), 1e-9);
+      }
+  // On a grid that keeps its voxels the labels stay with the input unless asked for.
+  RenderVolume coarse_ct = v;
+  coarse_ct.geometry.spacing_mm = Vec3(1.5, 1.5, 1.5);
+  std::optional<RenderVolume> same_storage;
+  const RenderVolume& same = volume_as_viewed(coarse_ct, same_storage, /*with_labels=*/false);
+  EXPECT_EQ(same.geometry.dims, v.geometry.dims);
+  EXPECT_TRUE(same.labels.empty());
+}
+
 TEST(RenderSmoothing, PremultipliedColoursScaleByAlpha) {
   LabelColours c;
   c.rgba[7] = {200, 100, 50, 128};
