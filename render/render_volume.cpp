@@ -13,19 +13,31 @@ RenderVolume RenderVolume::from(const Volume& ct, const Volume* labels) {
   RenderVolume v;
   v.geometry = ct.geometry();
   v.hu = ct.to_float32();
-  v.hu_is_int16 = std::all_of(v.hu.begin(), v.hu.end(), [](float x) {
-    return x >= -32767.0f && x <= 32767.0f && x == std::nearbyint(x);
-  });
+  const int64_t n = ct.voxel_count();
+  bool all_int16 = true;
+#pragma omp parallel for schedule(static) reduction(&& : all_int16)
+  for (int64_t i = 0; i < n; ++i) {
+    const float x = v.hu[std::size_t(i)];
+    all_int16 = all_int16 && x >= -32767.0f && x <= 32767.0f && x == std::nearbyint(x);
+  }
+  v.hu_is_int16 = all_int16;
   if (labels) {
     if (!labels->geometry().same_grid(ct.geometry(), 1e-3))
       throw InputError("the label map's voxel grid differs from the CT's; the renderer needs them on one grid");
-    v.labels.resize(ct.voxel_count());
-    for (int64_t n = 0; n < ct.voxel_count(); ++n) {
-      const double id = labels->value(n);
-      if (!(id >= 0 && id < kExteriorAirLabel) || id != std::floor(id))
-        throw InputError("label map value " + std::to_string(id) + " is not an id from 0 to 65534");
-      v.labels[n] = static_cast<uint16_t>(id);
-    }
+    v.labels.resize(std::size_t(n));
+    // Typed, not through Volume::value: a 0.75 mm CT has 10⁸ voxels. The first bad voxel (lowest
+    // index) is the one reported, whatever the thread count.
+    int64_t first_bad = n;
+    dispatch_voxel_type(labels->type(), const_cast<void*>(labels->raw()), [&](auto* p) {
+#pragma omp parallel for schedule(static) reduction(min : first_bad)
+      for (int64_t i = 0; i < n; ++i) {
+        const double id = double(p[i]);
+        if (!(id >= 0 && id < kExteriorAirLabel) || id != std::floor(id)) first_bad = std::min(first_bad, i);
+        else v.labels[std::size_t(i)] = static_cast<uint16_t>(id);
+      }
+    });
+    if (first_bad < n)
+      throw InputError("label map value " + std::to_string(labels->value(first_bad)) + " is not an id from 0 to 65534");
   }
   return v;
 }

@@ -9,7 +9,10 @@
 #include <cmath>
 #include <optional>
 #include <random>
+#include <string>
 
+#include "core/error.h"
+#include "io/volume.h"
 #include "render/render_volume.h"
 #include "render/view_settings.h"
 
@@ -201,6 +204,27 @@ TEST(RenderSmoothing, TheViewsGridKeepsTheFullFilterAtEveryKeptVoxel) {
   const RenderVolume& same = volume_as_viewed(coarse_ct, same_storage, /*with_labels=*/false);
   EXPECT_EQ(same.geometry.dims, v.geometry.dims);
   EXPECT_TRUE(same.labels.empty());
+}
+
+// The label map's ids reach the renderer exactly, and the first voxel that is no id (negative,
+// fractional or beyond 16 bits) is named, whatever the thread count.
+TEST(RenderVolumeFrom, LabelsArriveExactlyAndTheFirstBadOneIsNamed) {
+  Geometry g;
+  g.dims = {7, 5, 3};
+  Volume ct(g, VoxelType::Int16), labels(g, VoxelType::Int32);
+  for (int64_t n = 0; n < g.voxel_count(); ++n) ct.data<int16_t>()[n] = int16_t(n - 50), labels.data<int32_t>()[n] = int32_t(3 * n);
+  const RenderVolume v = RenderVolume::from(ct, &labels);
+  ASSERT_EQ(int64_t(v.labels.size()), g.voxel_count());
+  for (int64_t n = 0; n < g.voxel_count(); ++n) ASSERT_EQ(v.labels[std::size_t(n)], uint16_t(3 * n));
+  EXPECT_TRUE(v.hu_is_int16);
+  labels.data<int32_t>()[90] = 70000;
+  labels.data<int32_t>()[60] = -2;
+  try {
+    RenderVolume::from(ct, &labels);
+    FAIL() << "a label map with -2 and 70000 was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("-2"), std::string::npos) << e.what();
+  }
 }
 
 TEST(RenderSmoothing, PremultipliedColoursScaleByAlpha) {
