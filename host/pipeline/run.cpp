@@ -85,7 +85,7 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
 
   // Simulate: roles, mesh, solver (from the checkpoint with --resume).
   log::info("stage 1/4: roles, mesh and solver");
-  Simulation sim = prepare_simulation(scene);
+  Simulation sim = prepare_simulation(scene, /*keep_inputs=*/true);   // the warp reads them too
   check_cavity_label_free(scene, sim.roles);
   scene_label_names(scene);   // a bad names file is refused now, not after the solve
   SolveHooks hooks;
@@ -139,15 +139,13 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
 
   // Warp, then render with the warp's point mapping (ports travel with the skin).
   log::info("stage 2/4: warp");
-  // The simulation's roles, mesh and shape, not rebuilt; only the input volumes are read again (the
-  // roles keep a padded float copy, the outputs need the originals' grids and types).
+  // The simulation's roles, mesh and shape, not rebuilt, and the input volumes as the roles stage
+  // read them (the roles keep a padded float copy; the outputs need the originals' grids and types).
   Deformation solved;
   solved.displacement_m = displacements(sim.mesh, sim.result.x);
   solved.pressure_pa = sim.result.final_pressure_pa;
   solved.converged = sim.result.converged;
-  std::optional<Volume> input_labels;
-  if (!scene.inputs.labels.empty()) input_labels = read_volume(scene.inputs.labels);
-  const WarpedCase w = warp_solved(scene, read_volume(scene.require_ct()), std::move(input_labels),
+  const WarpedCase w = warp_solved(scene, std::move(*sim.inputs.ct), std::move(sim.inputs.labels),
                                    std::move(sim.roles), std::move(sim.mesh), std::move(solved));
   write_warp(scene, w, o.out_dir);
   const PointMap point_map = w.point_map();

@@ -24,13 +24,18 @@ RoleVolume assign_roles(const Scene& scene, const Volume& ct, const Volume* labe
   return assign_roles(scene.roles, ct, labels, input_names(scene));
 }
 
-RoleVolume load_roles(const Scene& scene) {
+RoleVolume load_roles(const Scene& scene, InputVolumes* inputs) {
   const bool have_labels = !scene.inputs.labels.empty();
   require_labels_if_needed(scene.roles, have_labels, input_names(scene));   // before reading a large CT for nothing
-  const Volume ct = read_volume(scene.require_ct());
-  if (!have_labels) return assign_roles(scene, ct, nullptr);
-  const Volume labels = read_volume(scene.inputs.labels);
-  return assign_roles(scene, ct, &labels);
+  Volume ct = read_volume(scene.require_ct());
+  std::optional<Volume> labels;
+  if (have_labels) labels = read_volume(scene.inputs.labels);
+  RoleVolume roles = assign_roles(scene, ct, labels ? &*labels : nullptr);
+  if (inputs) {
+    inputs->ct = std::move(ct);
+    inputs->labels = std::move(labels);
+  }
+  return roles;
 }
 
 Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene, bool to_solve) {

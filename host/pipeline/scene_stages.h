@@ -2,6 +2,9 @@
 // The one place a scene becomes what each stage takes: the stages (roles, mesh, solve) know their
 // own options and nothing of the scene file (the build enforces it: cmake/Layers.cmake); these
 // read a scene's sections, convert units to the stages' (SI inside), and call them.
+#include <optional>
+
+#include "io/volume.h"
 #include "mesh/mesh.h"
 #include "roles/roles.h"
 #include "scene/scene.h"
@@ -12,8 +15,12 @@ namespace pneumo {
 /// roles.* and the inputs' names for messages, then assign_roles (roles/roles.h).
 RoleVolume assign_roles(const Scene& scene, const Volume& ct, const Volume* labels);
 
-/// Reads inputs.ct (and inputs.labels when given), then assign_roles.
-RoleVolume load_roles(const Scene& scene);
+/// Reads inputs.ct (and inputs.labels when given), then assign_roles. With `inputs`, the volumes
+/// read are handed back there (what a run's warp reads again otherwise).
+struct InputVolumes {
+  std::optional<Volume> ct, labels;
+};
+RoleVolume load_roles(const Scene& scene, InputVolumes* inputs = nullptr);
 
 /// The mesh of a case: mesh.* (the cube size from the CT's spacing when mesh.cube_mm is set),
 /// material.* per role, label and HU (Scene::young_kpa_for, poisson_for), masses and springs. With

@@ -43,11 +43,11 @@ void throw_if_stopped_inverted(const SolveResult& r, const Mesh& m, double targe
 }
 }  // namespace
 
-Simulation prepare_simulation(const Scene& scene) {
+Simulation prepare_simulation(const Scene& scene, bool keep_inputs) {
   fit_threads_to_load();
   Simulation sim;
   auto t0 = std::chrono::steady_clock::now();
-  sim.roles = load_roles(scene);
+  sim.roles = load_roles(scene, keep_inputs ? &sim.inputs : nullptr);
   sim.stage_seconds_roles = seconds_since(t0);
 
   t0 = std::chrono::steady_clock::now();

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "mesh/mesh.h"
+#include "pipeline/scene_stages.h"
 #include "roles/roles.h"
 #include "scene/scene.h"
 #include "solve/solver.h"
@@ -33,6 +34,7 @@ struct Simulation {
   SolveResult result;                         // at the scene's load.pressure_mmhg
   std::vector<PressurePoint> pressure_curve;  // when the scene lists pressures (§9), in order
   std::string device;   // "cpu" or "opencl:P:D <name>"
+  InputVolumes inputs;  // the CT and labels as read, when prepare_simulation was asked to keep them
   double stage_seconds_roles = 0, stage_seconds_mesh = 0, stage_seconds_solve = 0;
 };
 
@@ -40,8 +42,9 @@ struct Simulation {
 /// prepare_simulation then solve_simulation. A DivergedError propagates.
 Simulation simulate_scene(const Scene& scene);
 
-/// Roles and mesh (InputError when the mesh has no cavity faces).
-Simulation prepare_simulation(const Scene& scene);
+/// Roles and mesh (InputError when the mesh has no cavity faces). With `keep_inputs` the CT and
+/// label map stay in Simulation::inputs for a later stage (a run's warp), instead of being read again.
+Simulation prepare_simulation(const Scene& scene, bool keep_inputs = false);
 
 /// What a caller adds to a solve: a start state (a resumed run's checkpoint) and an observer of
 /// the solver's progress (checkpoints, the inflation preview).
