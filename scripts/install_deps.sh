@@ -17,8 +17,8 @@ packages=(
   # image output; ffmpeg (with ffprobe) encodes the fly-through and inflation-preview MP4s
   libstb-dev ffmpeg
   # volume I/O; HDF5 writes the ITK transform file of the displacement field, GDCM reads DICOM
-  # series, teem reads and writes NRRD
-  libnifti2-dev zlib1g-dev libhdf5-dev libgdcm-dev libteem-dev
+  # series, teem reads and writes NRRD, libdeflate compresses .nii.gz on every core
+  libnifti2-dev zlib1g-dev libdeflate-dev libhdf5-dev libgdcm-dev libteem-dev
   # CLI and scenes
   libcli11-dev nlohmann-json3-dev
   # `pneumo serve`: cpp-httplib serves the page; the browser test drives Chromium through Selenium

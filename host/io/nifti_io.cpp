@@ -1,11 +1,11 @@
 // NIfTI-1 (.nii, .nii.gz) through niftilib. The 348-byte header is read and checked here first, so
 // every problem gets a specific message and nothing the header promises is allocated before it is
-// checked against the file; niftilib then converts the header (quaternions, sform) and writes.
+// checked against the file; niftilib then converts the header (quaternions, sform) both ways. The
+// bytes are written here: a .nii.gz as gzip members on every core (io/gzip_members.h).
 #include <nifti2_io.h>
 #include <zlib.h>
 
 #include <sys/stat.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -19,6 +19,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/progress.h"
+#include "io/gzip_members.h"
 #include "io/volume_io.h"
 
 namespace pneumo {
@@ -26,6 +27,8 @@ namespace pneumo {
 namespace {
 
 constexpr int kNifti1HeaderBytes = 348;
+// libdeflate's fastest level for .nii.gz: a CT compresses little better at higher ones.
+constexpr int kNiftiGzipLevel = 1;
 // gzip's deflate cannot expand more than about 1032:1; a .gz file smaller than payload/1032 is
 // truncated whatever it says.
 constexpr uint64_t kMaxDeflateRatio = 1032;
@@ -92,67 +95,6 @@ struct NimDeleter {
 using NimPtr = std::unique_ptr<nifti_image, NimDeleter>;
 
 bool is_gz(const std::string& path) { return volume_format_from_path(path) == VolumeFormat::NiftiGz; }
-
-/// Whether `path` is a whole gzip stream of `bytes` uncompressed bytes: the magic at its start and
-/// the ISIZE of its trailer (RFC 1952: the length mod 2^32, the last 4 bytes, little-endian).
-/// niftilib writes through gzwrite without checking it, so a full disk leaves a stream cut anywhere;
-/// its last four bytes then match by chance 1 time in 2^32.
-bool whole_gzip(const std::string& path, uint64_t bytes) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return false;
-  unsigned char magic[2] = {0, 0}, tail[4] = {0, 0, 0, 0};
-  const bool read = std::fread(magic, 1, 2, f) == 2 && std::fseek(f, -4, SEEK_END) == 0 && std::fread(tail, 1, 4, f) == 4;
-  std::fclose(f);
-  const uint32_t isize = uint32_t(tail[0]) | uint32_t(tail[1]) << 8 | uint32_t(tail[2]) << 16 | uint32_t(tail[3]) << 24;
-  return read && magic[0] == 0x1f && magic[1] == 0x8b && isize == uint32_t(bytes);
-}
-
-/// Sends what niftilib prints on stderr to a temporary file for the life of the object, so that a
-/// failed write is reported once, by pneumo, naming the final file (niftilib names the temporary
-/// one). Writes are serialised: stderr is one per process.
-class CapturedStderr {
- public:
-  CapturedStderr() : lock_(mutex()) {
-    std::fflush(stderr);
-    saved_ = ::dup(2);
-    file_ = std::tmpfile();
-    if (saved_ >= 0 && file_) {
-      ::dup2(::fileno(file_), 2);
-    } else {   // nowhere to put it: leave stderr as it is
-      if (file_) std::fclose(file_);
-      if (saved_ >= 0) ::close(saved_);
-      file_ = nullptr;
-      saved_ = -1;
-    }
-  }
-  ~CapturedStderr() { restore(); }
-  /// Restores stderr; returns what was printed meanwhile.
-  std::string restore() {
-    std::string text;
-    if (saved_ < 0) return text;
-    std::fflush(stderr);
-    ::dup2(saved_, 2);
-    ::close(saved_);
-    saved_ = -1;
-    if (file_) {
-      std::rewind(file_);
-      char buf[4096];
-      for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, file_)) > 0;) text.append(buf, n);
-      std::fclose(file_);
-      file_ = nullptr;
-    }
-    return text;
-  }
-
- private:
-  static std::mutex& mutex() {
-    static std::mutex m;
-    return m;
-  }
-  std::lock_guard<std::mutex> lock_;
-  int saved_ = -1;
-  std::FILE* file_ = nullptr;
-};
 
 uint64_t file_size(const std::string& path) {
   struct stat st {};
@@ -390,22 +332,30 @@ void write_nifti_image(const Geometry& g, const int64_t dims[8], int datatype, c
   }
   std::snprintf(nim->descrip, sizeof nim->descrip, "pneumo %s", PNEUMO_VERSION);
 
+  // The header as niftilib fills it in; the bytes written here: the 348-byte header, the 4-byte
+  // extender (no extensions), the voxels from byte 352. A .nii.gz as gzip members deflated on every
+  // core (io/gzip_members.h) at the fastest level, where niftilib's gzwrite used one core (a CT
+  // compresses little better at zlib's default 6).
+  nifti_set_iname_offset(nim.get(), 1);
+  nifti_1_header header{};
+  if (nifti_convert_nim2n1hdr(nim.get(), &header) != 0 || header.vox_offset != 352.0f)
+    throw std::runtime_error(path + ": niftilib could not fill a NIfTI-1 header");
+  const unsigned char extender[4] = {0, 0, 0, 0};
   AtomicFile out(path);
-  if (nifti_set_filenames(nim.get(), out.temp_path().c_str(), 0, 1) != 0)
-    throw std::runtime_error(path + ": niftilib rejected the file name " + out.temp_path());
-  nim->data = const_cast<void*>(data);
-  // zlib level 1: the fastest level (CT compresses little better at the default 6). Returns nothing useful:
-  // check what it wrote.
-  CapturedStderr niftilib_messages;
-  nifti_image_write_hdr_img(nim.get(), 1, "wb1");
-  const std::string printed = niftilib_messages.restore();
-  const uint64_t bytes = 352 + payload;   // header, extender, voxels
-  struct stat st {};
-  const bool wrote = is_gz(path) ? whole_gzip(out.temp_path(), bytes)
-                                 : ::stat(out.temp_path().c_str(), &st) == 0 && uint64_t(st.st_size) >= bytes;
-  if (!wrote) throw std::runtime_error(path + ": writing failed: the file came out incomplete (disk full?); nothing was "
-                                       "written under this name");
-  if (!printed.empty()) std::fputs(printed.c_str(), stderr);   // niftilib's warnings on a good write
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(out.temp_path().c_str(), "wb"), &std::fclose);
+  if (!file) throw file_error(path, "cannot create " + out.temp_path() + ": " + std::strerror(errno));
+  unsigned char head[sizeof header + sizeof extender];
+  std::memcpy(head, &header, sizeof header);
+  std::memcpy(head + sizeof header, extender, sizeof extender);
+  if (is_gz(path)) {
+    write_gzip_members(file.get(), path, {{head, sizeof head}, {data, payload}}, kNiftiGzipLevel);
+  } else if (std::fwrite(head, 1, sizeof head, file.get()) != sizeof head ||
+             std::fwrite(data, 1, payload, file.get()) != payload) {
+    throw std::runtime_error(path + ": writing failed: " + std::strerror(errno) + " (disk full?)");
+  }
+  if (std::fflush(file.get()) != 0 || std::fclose(file.release()) != 0)
+    throw std::runtime_error(path + ": writing failed: " + std::strerror(errno) + " (disk full?); nothing was written "
+                             "under this name");
   out.commit();
 }
 

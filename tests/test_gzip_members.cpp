@@ -1,0 +1,116 @@
+// The parallel gzip writer (io/gzip_members.h) against zlib, the reader niftilib, ITK and VTK use:
+// what it writes inflates to exactly the bytes given, as one member per piece of at most
+// kGzipMemberBytes (each a whole gzip stream with its own CRC and length, RFC 1952), whatever the
+// thread count; and a full disk is an error, not a short file.
+#include <gtest/gtest.h>
+#include <omp.h>
+#include <zlib.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "io/gzip_members.h"
+
+namespace pneumo {
+namespace {
+
+struct Inflated {
+  std::vector<unsigned char> bytes;
+  int members = 0;
+  bool clean = true;   // every member ended with a good CRC and length, nothing left over
+};
+
+// Inflates member after member (windowBits 15 + 16: gzip, one stream per call to inflateInit2).
+Inflated inflate_members(const std::vector<unsigned char>& gz) {
+  Inflated r;
+  std::size_t at = 0;
+  std::vector<unsigned char> buf(1 << 16);
+  while (at < gz.size()) {
+    z_stream z{};
+    if (inflateInit2(&z, 15 + 16) != Z_OK) return {{}, 0, false};
+    z.next_in = const_cast<unsigned char*>(gz.data() + at);
+    z.avail_in = uInt(gz.size() - at);
+    int ret = Z_OK;
+    while (ret == Z_OK) {
+      z.next_out = buf.data();
+      z.avail_out = uInt(buf.size());
+      ret = inflate(&z, Z_NO_FLUSH);
+      r.bytes.insert(r.bytes.end(), buf.data(), buf.data() + (buf.size() - z.avail_out));
+    }
+    at = gz.size() - z.avail_in;
+    inflateEnd(&z);
+    if (ret != Z_STREAM_END) return {r.bytes, r.members, false};
+    ++r.members;
+  }
+  return r;
+}
+
+std::vector<unsigned char> written(const std::vector<ByteSpan>& parts, int threads) {
+  const std::string path = ::testing::TempDir() + "/gzip_members_" + std::to_string(threads) + ".gz";
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  EXPECT_NE(f, nullptr);
+  omp_set_num_threads(threads);
+  write_gzip_members(f, path, parts, 1);
+  std::fclose(f);
+  std::FILE* r = std::fopen(path.c_str(), "rb");
+  std::vector<unsigned char> gz;
+  for (int c; (c = std::fgetc(r)) != EOF;) gz.push_back(static_cast<unsigned char>(c));
+  std::fclose(r);
+  return gz;
+}
+
+TEST(GzipMembers, InflatesToTheBytesGivenOneMemberPerPiece) {
+  // A CT-like payload: smooth int16 with noise, 2.5 members long, after a 352-byte header.
+  std::vector<int16_t> voxels(std::size_t(kGzipMemberBytes * 5 / 2 / sizeof(int16_t)));
+  std::mt19937 rng(3);
+  std::normal_distribution<float> noise(0.0f, 20.0f);
+  for (std::size_t n = 0; n < voxels.size(); ++n) voxels[n] = int16_t(40.0f * std::sin(float(n) * 1e-3f) + noise(rng));
+  std::vector<unsigned char> head(352);
+  for (std::size_t n = 0; n < head.size(); ++n) head[n] = static_cast<unsigned char>(n * 7);
+  std::vector<unsigned char> expected(head);
+  const auto* v = reinterpret_cast<const unsigned char*>(voxels.data());
+  expected.insert(expected.end(), v, v + voxels.size() * sizeof(int16_t));
+
+  const int saved = omp_get_max_threads();
+  std::vector<unsigned char> first;
+  for (int threads : {1, 2, 3}) {
+    const std::vector<unsigned char> gz = written({{head.data(), head.size()}, {voxels.data(), voxels.size() * 2}}, threads);
+    const Inflated in = inflate_members(gz);
+    EXPECT_TRUE(in.clean) << threads << " threads";
+    EXPECT_EQ(in.members, 1 + 3) << "the header's member, then ceil(2.5) pieces";
+    EXPECT_TRUE(in.bytes == expected) << threads << " threads";
+    EXPECT_LT(gz.size(), expected.size());
+    if (first.empty()) first = gz;
+    EXPECT_TRUE(gz == first) << "the file depends on the thread count (" << threads << ")";
+  }
+  omp_set_num_threads(saved);
+}
+
+TEST(GzipMembers, AnEmptyPartIsAnEmptyMember) {
+  const unsigned char x[3] = {1, 2, 3};
+  const Inflated in = inflate_members(written({{x, 0}, {x, 3}}, 2));
+  EXPECT_TRUE(in.clean);
+  EXPECT_EQ(in.members, 2);
+  EXPECT_EQ(in.bytes, (std::vector<unsigned char>{1, 2, 3}));
+}
+
+TEST(GzipMembers, AFullDiskIsAnError) {
+  std::FILE* f = std::fopen("/dev/full", "wb");
+  if (!f) GTEST_SKIP() << "no /dev/full here";
+  std::vector<unsigned char> data(std::size_t(kGzipMemberBytes), 0);
+  std::mt19937 rng(1);
+  for (auto& b : data) b = static_cast<unsigned char>(rng());   // incompressible: one write larger than stdio's buffer
+  try {
+    write_gzip_members(f, "/dev/full", {{data.data(), data.size()}}, 1);
+    FAIL() << "writing to a full disk succeeded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("disk full"), std::string::npos) << e.what();
+  }
+  std::fclose(f);
+}
+
+}  // namespace
+}  // namespace pneumo
