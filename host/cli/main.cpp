@@ -8,6 +8,7 @@
 
 #include "cli/commands.h"
 #include "cli/unknown_subcommand.h"
+#include "core/allocator_policy.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
@@ -20,6 +21,7 @@ constexpr int kExitBadInput = 2;
 
 int main(int argc, char** argv) {
   using namespace pneumo;
+  keep_freed_memory_for_reuse();   // before the first large block
   CLI::App app{"pneumo: virtual pneumoperitoneum, from a CT to the laparoscope's view"};
   app.set_version_flag("--version", std::string("pneumo ") + PNEUMO_VERSION);
   app.require_subcommand(1);
