@@ -24,15 +24,16 @@ namespace {
 // 6 mm cubes; docs/fem.md). The solver follows the model; the model stays the scene's physics.
 //
 // The elements' figures: the real CT (scenes/totalseg_example.json, the default material) solved by Newton on the
-// CPU in that run, and its rise and warped cavity against the 3 mm cubes' answer (docs/fidelity.md §4).
+// CPU, and its rise and warped cavity against the 3 mm cubes' answer (docs/fidelity.md §4); the solve times
+// re-measured after the assembled stiffness (bench/results/2026-12-06-presets-real-ct.md), the answers unchanged.
 const PresetSettings kPreview{SolverMethod::Static, SolverMethod::Newton, 12.0, 1e-2,
-                              "the elements on the real CT: solve 7.1 s, rise +2.7 % and cavity +4.0 % of the 3 mm "
+                              "the elements on the real CT: solve 1.9 s, rise +2.7 % and cavity +4.0 % of the 3 mm "
                               "answer; the springs on the medium phantom: solve 0.36 s, error RMS 0.93 mm, max 5.6 mm"};
 const PresetSettings kBalanced{SolverMethod::Static, SolverMethod::Newton, 9.0, 1e-2,
-                               "the elements on the real CT: solve 15.8 s, rise +0.9 % and cavity +0.9 % of the 3 mm "
+                               "the elements on the real CT: solve 5.0 s, rise +0.9 % and cavity +0.9 % of the 3 mm "
                                "answer; the springs on the medium phantom: solve 0.86 s, error RMS 0.90 mm, max 10.6 mm"};
 const PresetSettings kAccurate{SolverMethod::Static, SolverMethod::Newton, 6.0, 1e-3,
-                               "the elements on the real CT: solve 94.1 s, rise -0.5 % and cavity -1.6 % of the 3 mm "
+                               "the elements on the real CT: solve 32.0 s, rise -0.5 % and cavity -1.6 % of the 3 mm "
                                "answer; the springs on the medium phantom: solve 5.4 s, error RMS 0.64 mm, max 4.8 mm"};
 
 }  // namespace
