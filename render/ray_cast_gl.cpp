@@ -211,11 +211,10 @@ void GlRayCaster::set_volume(const RenderVolume& v, bool force_float) {
   m.have_volume = true;
   log::debug("GL ray caster: volume " + std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" +
              std::to_string(d[2]) + " as " + m.hu_format +
-             (&viewed != &v && d != v.geometry.dims ? " (the views' grid, coarser than the CT's " +
-                                                          std::to_string(v.geometry.dims[0]) + "x" +
-                                                          std::to_string(v.geometry.dims[1]) + "x" +
-                                                          std::to_string(v.geometry.dims[2]) + ")"
-                                                    : std::string()));
+             (d != v.geometry.dims ? " (the views' grid, coarser than the CT's " + std::to_string(v.geometry.dims[0]) +
+                                         "x" + std::to_string(v.geometry.dims[1]) + "x" +
+                                         std::to_string(v.geometry.dims[2]) + ")"
+                                   : std::string()));
 }
 
 std::vector<int16_t> GlRayCaster::read_gradient_texture() {

@@ -216,7 +216,6 @@ const RenderVolume& volume_as_viewed(const RenderVolume& v, std::optional<Render
   storage.emplace();
   storage->geometry = view_grid(v.geometry, stride);
   storage->hu_is_int16 = v.hu_is_int16;
-  storage->views_on_ct_grid = v.views_on_ct_grid;
   storage->hu = gaussian_filter(v.hu.data(), v.geometry.dims, view_smoothing_sigma_voxels(v.geometry, v.smoothing_mm),
                                 stride);
   if (v.hu_is_int16) round_to_int16_hu(storage->hu);
@@ -284,11 +283,6 @@ LabelColours default_label_colours() {
   set({18, 19}, 250, 190, 170);    // small bowel, duodenum
   set({20}, 200, 150, 110);        // colon
   return c;
-}
-
-std::vector<uint8_t> label_colour_volume(const RenderVolume& v, const LabelColours& c) {
-  if (v.labels.empty()) return std::vector<uint8_t>(std::size_t(v.geometry.voxel_count()) * 4, 0);
-  return label_colour_volume(v.labels, c);
 }
 
 std::vector<uint8_t> label_colour_volume(const std::vector<uint16_t>& labels, const LabelColours& c) {

@@ -135,10 +135,7 @@ inline std::array<uint8_t, 4> premultiplied_colour(const LabelColours& c, uint16
   return {mul(q[0]), mul(q[1]), mul(q[2]), q[3]};
 }
 
-/// premultiplied_colour() of every voxel's label, 4 bytes per voxel (i fastest); all zero without
-/// labels. OpenMP over slices.
-std::vector<uint8_t> label_colour_volume(const RenderVolume& v, const LabelColours& c);
-/// The same for a label map on its own.
+/// premultiplied_colour() of every voxel's label, 4 bytes per voxel (i fastest). OpenMP over voxels.
 std::vector<uint8_t> label_colour_volume(const std::vector<uint16_t>& labels, const LabelColours& c);
 
 /// Empty-space skipping: block (bx, by, bz) covers voxel centres [b·B, (b+1)·B] on each axis

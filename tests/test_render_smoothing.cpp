@@ -237,7 +237,7 @@ TEST(RenderSmoothing, PremultipliedColoursScaleByAlpha) {
   EXPECT_EQ(none, (std::array<uint8_t, 4>{0, 0, 0, 0}));
   RenderVolume v = grid_volume({2, 1, 1});
   v.labels = {8, 9};
-  const std::vector<uint8_t> vol = label_colour_volume(v, c);
+  const std::vector<uint8_t> vol = label_colour_volume(v.labels, c);
   EXPECT_EQ(vol, (std::vector<uint8_t>{200, 100, 50, 255, 0, 0, 0, 0}));
 }
 
