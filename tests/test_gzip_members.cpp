@@ -52,8 +52,10 @@ std::vector<unsigned char> written(const std::vector<ByteSpan>& parts, int threa
   const std::string path = ::testing::TempDir() + "/gzip_members_" + std::to_string(threads) + ".gz";
   std::FILE* f = std::fopen(path.c_str(), "wb");
   EXPECT_NE(f, nullptr);
+  const int saved = omp_get_max_threads();
   omp_set_num_threads(threads);
   write_gzip_members(f, path, parts, 1);
+  omp_set_num_threads(saved);   // other tests in this process keep theirs
   std::fclose(f);
   std::FILE* r = std::fopen(path.c_str(), "rb");
   std::vector<unsigned char> gz;
@@ -74,7 +76,6 @@ TEST(GzipMembers, InflatesToTheBytesGivenOneMemberPerPiece) {
   const auto* v = reinterpret_cast<const unsigned char*>(voxels.data());
   expected.insert(expected.end(), v, v + voxels.size() * sizeof(int16_t));
 
-  const int saved = omp_get_max_threads();
   std::vector<unsigned char> first;
   for (int threads : {1, 2, 3}) {
     const std::vector<unsigned char> gz = written({{head.data(), head.size()}, {voxels.data(), voxels.size() * 2}}, threads);
@@ -86,7 +87,6 @@ TEST(GzipMembers, InflatesToTheBytesGivenOneMemberPerPiece) {
     if (first.empty()) first = gz;
     EXPECT_TRUE(gz == first) << "the file depends on the thread count (" << threads << ")";
   }
-  omp_set_num_threads(saved);
 }
 
 TEST(GzipMembers, AnEmptyPartIsAnEmptyMember) {
