@@ -67,6 +67,44 @@ TEST(CavityMeasures, AGridStoredBackToFrontGivesTheSameCount) {
   EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {kBladder}), 2);
 }
 
+// The space of Retzius against the peritoneum over the bladder: the column's gas (y = 5, 6) lies on
+// the floor voxel y = 4. Traced to rest, a floor that touched no intraperitoneal organ there counts
+// (the gas opened in front of the bladder); one that had the bowel within a voxel does not (the gas
+// lies where the bowel lay on the peritoneum); a floor no tetrahedron carries counts.
+TEST(CavityMeasures, GasOnTissueThatABowelLoopCoveredAtRestIsPeritoneal) {
+  constexpr uint16_t kBowel = 18;
+  for (const Mat3& direction : {Mat3(Mat3::Identity()), Mat3(Vec3(-1, -1, 1).asDiagonal())}) {
+    const Column c(direction);
+    const bool flipped = direction(1, 1) < 0;
+    auto rest_at = [&](std::vector<uint16_t>& rest, int i, int front_index, int k) -> uint16_t& {
+      return rest[std::size_t(c.g.linear_index(i, flipped ? 7 - front_index : front_index, k))];
+    };
+    std::vector<uint16_t> rest_labels(c.labels.size(), 0);
+    rest_at(rest_labels, 1, 3, 0) = kBladder;
+    RestColumns rest;
+    rest.labels = rest_labels.data();
+    rest.grid = c.g;
+    rest.to_rest = [](const Vec3& p) { return std::optional<Vec3>(p); };   // nothing moved
+    EXPECT_EQ(gas_voxels_in_prevesical_space(c.labels, c.g, kGas, {kBladder}, {kBowel}, rest), 2);
+
+    // The bowel lay on the floor's cranial face: peritoneal.
+    rest_at(rest_labels, 1, 4, 1) = kBowel;
+    EXPECT_EQ(gas_voxels_in_prevesical_space(c.labels, c.g, kGas, {kBladder}, {kBowel}, rest), 0);
+    // …but two voxels away from it, in front of the gas, it covered nothing under the gas.
+    rest_at(rest_labels, 1, 4, 1) = 0;
+    rest_at(rest_labels, 1, 6, 1) = kBowel;
+    EXPECT_EQ(gas_voxels_in_prevesical_space(c.labels, c.g, kGas, {kBladder}, {kBowel}, rest), 2);
+
+    // The floor is traced: where it came from two voxels further forward, the bowel touched it.
+    const Vec3 forward = c.g.to_world(Vec3(0, flipped ? -2 : 2, 0)) - c.g.to_world(Vec3(0, 0, 0));
+    rest.to_rest = [forward](const Vec3& p) { return std::optional<Vec3>(p + forward); };
+    EXPECT_EQ(gas_voxels_in_prevesical_space(c.labels, c.g, kGas, {kBladder}, {kBowel}, rest), 0);
+    // A floor that no tetrahedron carries counts.
+    rest.to_rest = [](const Vec3&) { return std::optional<Vec3>(); };
+    EXPECT_EQ(gas_voxels_in_prevesical_space(c.labels, c.g, kGas, {kBladder}, {kBowel}, rest), 2);
+  }
+}
+
 TEST(CavityMeasures, PosteriorMotionIsAveragedOverTheAnteriorHalfOfTheViscera) {
   Mesh m;
   // Viscera nodes at y = 0, 10, 20, 30 mm; a wall node at 40 mm.

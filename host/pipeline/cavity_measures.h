@@ -3,6 +3,8 @@
 // "A human answer" (docs/fidelity.md): gas in front of an extraperitoneal organ, and the viscera's
 // posterior motion where the gas pushes them.
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <vector>
 
 #include "core/geometry.h"
@@ -19,6 +21,26 @@ namespace pneumo {
 /// (the space of Retzius, extraperitoneal), where none should open.
 int64_t gas_voxels_anterior_to(const std::vector<uint16_t>& labels, const Geometry& g, uint16_t gas_label,
                                const std::vector<int>& ids, const std::vector<int>& stop_ids = {});
+
+/// Where the deformed frame's organ lay before the deformation: the label map at rest on its grid,
+/// and the map of a deformed point (world mm) to where its tissue was (nullopt: no tetrahedron
+/// carries it; warp/point_map.h).
+struct RestColumns {
+  const uint16_t* labels = nullptr;
+  Geometry grid;
+  std::function<std::optional<Vec3>(const Vec3& deformed_mm)> to_rest;
+};
+
+/// Gas in the prevesical space (the space of Retzius): gas_voxels_anterior_to with `stop_ids`, less
+/// the columns whose gas lies on peritoneum. Each column's floor (the voxel behind its first gas
+/// voxel, between the gas and the organ) is traced to rest; where a voxel of `stop_ids` lay within
+/// one voxel of it there, the gas opened on the face an intraperitoneal organ covered: the peritoneum
+/// over the bladder's dome, where a bowel loop lay and left as the wall rose (the supravesical fossa).
+/// In the space of Retzius no intraperitoneal organ touches the tissue in front of the bladder, so
+/// gas there counts, and so does gas whose floor no tetrahedron carries.
+int64_t gas_voxels_in_prevesical_space(const std::vector<uint16_t>& labels, const Geometry& g, uint16_t gas_label,
+                                       const std::vector<int>& ids, const std::vector<int>& stop_ids,
+                                       const RestColumns& rest);
 
 /// The mean posterior displacement (mm, positive = towards the back) of the viscera nodes in the
 /// anterior half of the viscera's rest extent from back to front (world y, RAS): where the gas lies

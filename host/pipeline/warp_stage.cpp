@@ -294,16 +294,30 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
     j["cavity_outside_largest_piece_fraction"] =
         w.cavity_voxels() > 0 ? 1.0 - double(largest) / double(w.cavity_voxels()) : 0.0;
     // Gas in front of the extraperitoneal organs the roles keep attached (the bladder), in the
-    // deformed frame: all of it, and the part with no intraperitoneal organ between it and the
-    // bladder (the space of Retzius, where none should open).
+    // deformed frame: all of it; the part with no intraperitoneal organ between it and the bladder;
+    // and of that, the part in front of bladder that no intraperitoneal organ covered at rest (the
+    // space of Retzius, where none should open; cavity_measures.h).
     if (!scene.roles.auto_prevesical_labels.empty()) {
       const uint16_t gas_id = uint16_t(scene.output.cavity_label);
       const auto& bladder = scene.roles.auto_prevesical_labels;
+      const auto& organs = scene.roles.viscera_labels;
       j["gas_anterior_to_prevesical_labels_ml"] =
           double(gas_voxels_anterior_to(w.result.labels, w.output_grid, gas_id, bladder)) * w.voxel_volume_ml;
-      j["gas_in_prevesical_space_ml"] =
-          double(gas_voxels_anterior_to(w.result.labels, w.output_grid, gas_id, bladder, scene.roles.viscera_labels)) *
-          w.voxel_volume_ml;
+      const int64_t short_of_organs = gas_voxels_anterior_to(w.result.labels, w.output_grid, gas_id, bladder, organs);
+      j["gas_short_of_intraperitoneal_organs_ml"] = double(short_of_organs) * w.voxel_volume_ml;
+      int64_t prevesical = 0;
+      if (short_of_organs > 0) {
+        const PointMap map = w.point_map();
+        RestColumns rest;
+        rest.labels = w.roles.label.empty() ? nullptr : w.roles.label.data();
+        rest.grid = w.roles.geometry;
+        rest.to_rest = [&map](const Vec3& deformed_mm) -> std::optional<Vec3> {
+          const MappedPoint p = map.to_original(deformed_mm);
+          return p.carried ? std::optional<Vec3>(p.point_mm) : std::nullopt;
+        };
+        prevesical = gas_voxels_in_prevesical_space(w.result.labels, w.output_grid, gas_id, bladder, organs, rest);
+      }
+      j["gas_in_prevesical_space_ml"] = double(prevesical) * w.voxel_volume_ml;
     }
   }
   j["warp"] = {{"device", w.result.device},
