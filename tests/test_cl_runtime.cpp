@@ -25,6 +25,28 @@ TEST(DeviceSpec, ParsesTheThreeForms) {
   EXPECT_EQ(given.device, 2);
 }
 
+// "auto": a GPU or accelerator wherever it is listed, the C++ reference where only CPU devices (PoCL,
+// on the reference's own cores) or none are.
+TEST(DeviceSpec, AutoPicksTheFirstGpuOrAcceleratorElseTheReference) {
+  auto device = [](int p, int d, const char* type) {
+    ocl::DeviceInfo i;
+    i.platform_index = p;
+    i.device_index = d;
+    i.type = type;
+    return i;
+  };
+  EXPECT_EQ(ocl::auto_device({}), "cpu");
+  EXPECT_EQ(ocl::auto_device({device(0, 0, "cpu")}), "cpu");
+  EXPECT_EQ(ocl::auto_device({device(0, 0, "cpu"), device(1, 0, "gpu"), device(1, 1, "gpu")}), "opencl:1:0");
+  EXPECT_EQ(ocl::auto_device({device(0, 0, "cpu"), device(0, 1, "accelerator")}), "opencl:0:1");
+  EXPECT_EQ(ocl::auto_device({device(0, 0, "other")}), "cpu");
+  // On this machine: the choice for the devices listed here, named in the spec's text.
+  const ocl::DeviceSpec chosen = ocl::parse_device_spec("auto");
+  const std::string expected = ocl::auto_device(ocl::list_devices());
+  EXPECT_EQ(chosen.text, expected);
+  EXPECT_EQ(chosen.use_opencl, expected != "cpu");
+}
+
 TEST(DeviceSpec, RejectsAnythingElseWithTheAllowedForms) {
   for (const char* bad : {"gpu", "opencl:", "opencl:0", "opencl:a:b", "OpenCL", "", "opencl:0:0:0"}) {
     try {

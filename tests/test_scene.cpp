@@ -329,11 +329,12 @@ TEST(SceneErrors, RulesBeyondRanges) {
   EXPECT_CONTAINS(error_of({{"load", {{"pressure_curve_mmhg", {0, 0.01, 5}}}}}),
                   "is not allowed; non-decreasing, each 0 (rest) or at least 0.1");
   EXPECT_EQ(error_of({{"load", {{"pressure_curve_mmhg", {0, 0.5, 5}}}}}), "");
-  EXPECT_CONTAINS(error_of({{"device", "gpu"}}), "device = \"gpu\" is not allowed; \"cpu\", \"opencl\", \"opencl:P:D\"");
+  EXPECT_CONTAINS(error_of({{"device", "gpu"}}), "device = \"gpu\" is not allowed; \"cpu\", \"auto\", \"opencl\", \"opencl:P:D\"");
   EXPECT_NE(error_of({{"device", "opencl:0"}}), "");
   EXPECT_NE(error_of({{"device", "opencl:a:1"}}), "");
   EXPECT_EQ(error_of({{"device", "opencl:1:0"}}), "");
   EXPECT_EQ(error_of({{"device", "opencl"}}), "");
+  EXPECT_EQ(error_of({{"device", "auto"}}), "");
   EXPECT_EQ(error_of({{"$schema_version", 1}}), "");
   json j = full_scene();
   j["render"]["cameras"][0]["name"] = "a/b";

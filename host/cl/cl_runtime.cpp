@@ -107,7 +107,21 @@ std::string no_device_hint() {
          ") is a writable folder; POCL_DEBUG=1 shows why a platform has no device";
 }
 
+std::string auto_device(const std::vector<DeviceInfo>& devices) {
+  for (const DeviceInfo& d : devices)
+    if (d.type == "gpu" || d.type == "accelerator") return d.spec();
+  return "cpu";
+}
+
 DeviceSpec parse_device_spec(const std::string& text) {
+  if (text == "auto") {
+    static const std::string chosen = [] {
+      const std::string c = auto_device(list_devices());
+      log::info("device auto: " + c + (c == "cpu" ? " (no OpenCL GPU or accelerator)" : ""));
+      return c;
+    }();
+    return parse_device_spec(chosen);
+  }
   DeviceSpec s;
   s.text = text;
   if (text == "cpu") return s;
@@ -120,7 +134,7 @@ DeviceSpec parse_device_spec(const std::string& text) {
     s.device = std::stoi(m[2]);
     return s;
   }
-  throw InputError("device '" + text + "' is not valid: use cpu, opencl or opencl:P:D (see `pneumo devices`)");
+  throw InputError("device '" + text + "' is not valid: use cpu, auto, opencl or opencl:P:D (see `pneumo devices`)");
 }
 
 Context::Context(const cl::Device& d, const DeviceInfo& info)

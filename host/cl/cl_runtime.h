@@ -43,8 +43,16 @@ std::vector<DeviceInfo> list_devices();
 /// Why list_devices() may be empty on this machine (ICD files, PoCL's cache folder), for messages.
 std::string no_device_hint();
 
-/// What the user asked for: "cpu" (the plain C++ reference), "opencl" (first OpenCL device) or
-/// "opencl:P:D". Throws InputError for anything else.
+/// The device "auto" stands for among `devices`: the first GPU or accelerator ("opencl:P:D"), or
+/// "cpu" (the C++ reference) where there is none. An OpenCL device of type CPU (PoCL) runs on the
+/// cores the reference runs on, and was slower than it at every stage measured on the default
+/// finite elements (docs/performance.md, "Which device": the large phantom's warp 6.1 s against
+/// 3.6 s, the medium phantom's `balanced` run 20.9 s against 7.4 s).
+std::string auto_device(const std::vector<DeviceInfo>& devices);
+
+/// What the user asked for: "cpu" (the plain C++ reference), "opencl" (first OpenCL device),
+/// "opencl:P:D", or "auto" (auto_device of the devices this machine has, chosen once per process;
+/// `text` then names the device chosen). Throws InputError for anything else.
 struct DeviceSpec {
   bool use_opencl = false;
   int platform = -1, device = -1;   // -1: the first one found

@@ -18,7 +18,7 @@ Run add_run(CLI::App& app) {
   auto o = std::make_shared<Opts>();
   cmd->add_option("scene", o->scene, "Scene .json")->required();
   cmd->add_option("--out", o->out, "Output folder")->required();
-  cmd->add_option("--device", o->device, "cpu (the C++ reference), opencl or opencl:P:D; overrides the scene's device");
+  cmd->add_option("--device", o->device, "cpu (the C++ reference), auto (an OpenCL GPU if there is one, else cpu), opencl or opencl:P:D; overrides the scene's device");
   cmd->add_option("--backend", o->backend, "Offscreen OpenGL: auto, egl-device, egl-surfaceless or osmesa");
   cmd->add_flag("--force", o->force, "Replace the results of an earlier run in --out");
   cmd->add_flag("--resume", o->resume, "Continue an interrupted run in --out from its checkpoint.bin");

@@ -29,7 +29,7 @@ Run add_warp(CLI::App& app) {
   auto o = std::make_shared<Opts>();
   cmd->add_option("scene", o->scene, "Scene .json (the one simulated)")->required();
   cmd->add_option("--out", o->out, "Folder of `pneumo simulate SCENE --out DIR`; the results go there too")->required();
-  cmd->add_option("--device", o->device, "cpu (the C++ reference), opencl or opencl:P:D; overrides the scene's device");
+  cmd->add_option("--device", o->device, "cpu (the C++ reference), auto (an OpenCL GPU if there is one, else cpu), opencl or opencl:P:D; overrides the scene's device");
   cmd->add_flag("--force", o->force, "Overwrite the results of an earlier warp in --out");
   return [=] {
     Scene scene = load_scene(o->scene);

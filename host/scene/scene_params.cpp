@@ -14,9 +14,9 @@ namespace {
 // ---- rules the ranges cannot say ---------------------------------------------------------------
 
 bool is_device(const json& v) {
-  // "cpu", "opencl", "opencl:P:D" with P, D non-negative integers.
+  // "cpu", "auto", "opencl", "opencl:P:D" with P, D non-negative integers.
   const std::string s = v.get<std::string>();
-  if (s == "cpu" || s == "opencl") return true;
+  if (s == "cpu" || s == "auto" || s == "opencl") return true;
   const std::string prefix = "opencl:";
   if (s.compare(0, prefix.size(), prefix) != 0) return false;
   const std::string rest = s.substr(prefix.size());
@@ -473,8 +473,8 @@ const Table<Scene>& scene_table() {
       {"material", &Scene::material, material_table(), "Mass-spring-damper material (§4, §5)."},
       {"load", &Scene::load, load_table(), "Insufflation pressure and how it is applied (§5, §6)."},
       {"solver", &Scene::solver, solver_table(), "How equilibrium is reached (§6)."},
-      {"device", &Scene::device, "", any().rule("\"cpu\", \"opencl\", \"opencl:P:D\" (platform P, device D)", is_device),
-       "Where to compute: the C++ reference or an OpenCL device (`pneumo devices` lists them)."},
+      {"device", &Scene::device, "", any().rule("\"cpu\", \"auto\", \"opencl\", \"opencl:P:D\" (platform P, device D)", is_device),
+       "Where to compute: the C++ reference or an OpenCL device (`pneumo devices` lists them). \"auto\": the first OpenCL GPU or accelerator, the C++ reference where there is none (an OpenCL CPU device shares the reference's cores and was slower on every stage measured)."},
       {"render", &Scene::render, render_table(), "Laparoscope views (§8)."},
       {"output", &Scene::output, output_table(), "What is written besides the scene echo."},
       {"landmarks", &Scene::landmarks, landmark_table(), any().items(0, 1000),
