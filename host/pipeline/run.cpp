@@ -147,7 +147,6 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   solved.converged = sim.result.converged;
   const WarpedCase w = warp_solved(scene, std::move(*sim.inputs.ct), std::move(sim.inputs.labels),
                                    std::move(sim.roles), std::move(sim.mesh), std::move(solved));
-  write_warp(scene, w, o.out_dir);
   const PointMap point_map = w.point_map();
   const PointMapFn map = deformed_point_fn(point_map);
 
@@ -171,9 +170,18 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
     deformed_labels = deformed_label_volume(w, scene.output.cavity_label);
     what.labels_path = (out / "deformed_labels.nii.gz").string();
   }
-  const RenderRun rendered =
-      render_volumes(scene, ro, deformed_ct, deformed_labels ? &*deformed_labels : nullptr, what);
+  // The views first, from memory, and the warp's files after them: a user waits for the first view,
+  // not for deflating 10⁸ voxels. A render that fails still leaves the warp's files written.
+  RenderRun rendered;
+  try {
+    rendered = render_volumes(scene, ro, deformed_ct, deformed_labels ? &*deformed_labels : nullptr, what);
+  } catch (...) {
+    write_warp(scene, w, o.out_dir, &deformed_ct, deformed_labels ? &*deformed_labels : nullptr);
+    throw;
+  }
   const double seconds_render = seconds_since(t_render);
+  log::info("writing the warped CT and labels");
+  write_warp(scene, w, o.out_dir, &deformed_ct, deformed_labels ? &*deformed_labels : nullptr);
 
   // Report: landmarks, plots, metrics (complete), report.html last.
   log::info("stage 4/4: report");

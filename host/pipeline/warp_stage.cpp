@@ -74,9 +74,11 @@ template <class T>
 void fill_rounded(Volume& v, const std::vector<float>& hu) {
   T* out = v.data<T>();
   const double lo = double(std::numeric_limits<T>::lowest()), hi = double(std::numeric_limits<T>::max());
-  for (std::size_t n = 0; n < hu.size(); ++n) {
-    if constexpr (std::is_integral_v<T>) out[n] = T(std::clamp(std::nearbyint(double(hu[n])), lo, hi));
-    else out[n] = T(hu[n]);
+  const int64_t count = int64_t(hu.size());
+#pragma omp parallel for schedule(static)
+  for (int64_t n = 0; n < count; ++n) {
+    if constexpr (std::is_integral_v<T>) out[n] = T(std::clamp(std::nearbyint(double(hu[std::size_t(n)])), lo, hi));
+    else out[n] = T(hu[std::size_t(n)]);
   }
 }
 
@@ -271,7 +273,10 @@ Volume deformed_label_volume(const WarpedCase& w, int cavity_label) {
   if (!fits) t = VoxelType::UInt16;
   Volume v(w.output_grid, t);
   dispatch_voxel_type(t, v.raw(), [&](auto* p) {
-    for (std::size_t n = 0; n < w.result.labels.size(); ++n) p[n] = static_cast<std::remove_pointer_t<decltype(p)>>(w.result.labels[n]);
+    const int64_t count = int64_t(w.result.labels.size());
+#pragma omp parallel for schedule(static)
+    for (int64_t n = 0; n < count; ++n)
+      p[n] = static_cast<std::remove_pointer_t<decltype(p)>>(w.result.labels[std::size_t(n)]);
   });
   return v;
 }
@@ -357,15 +362,23 @@ class WarpOutputs {
 };
 }  // namespace
 
-void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir) {
+void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir, const Volume* deformed_ct,
+                const Volume* deformed_labels) {
   nlohmann::json metrics = read_metrics(dir);
   check_writable_target(in_dir(dir, "metrics.json"));
   // An earlier warp replaced (--force) stops counting as finished before its images are replaced.
   if (metrics.erase("warp") > 0) write_text_file_atomic(in_dir(dir, "metrics.json"), metrics.dump(2) + "\n");
   WarpOutputs outputs(dir);
-  if (scene.output.write_deformed_ct) write_volume(deformed_ct_volume(w), outputs.add("deformed_ct.nii.gz"));
+  std::optional<Volume> built_ct;   // 10⁸ voxels on a clinical CT: built once, when not given
+  auto after_ct = [&]() -> const Volume& {
+    if (deformed_ct) return *deformed_ct;
+    if (!built_ct) built_ct = deformed_ct_volume(w);
+    return *built_ct;
+  };
+  if (scene.output.write_deformed_ct) write_volume(after_ct(), outputs.add("deformed_ct.nii.gz"));
   if (scene.output.write_deformed_labels && w.labels) {
-    write_volume(deformed_label_volume(w, scene.output.cavity_label), outputs.add("deformed_labels.nii.gz"));
+    write_volume(deformed_labels ? *deformed_labels : deformed_label_volume(w, scene.output.cavity_label),
+                 outputs.add("deformed_labels.nii.gz"));
     // Their names and colours, for 3D Slicer and ITK-SNAP.
     const std::vector<LabelTableEntry> rows = deformed_label_entries(scene, w);
     write_slicer_colour_table(outputs.add("deformed_labels.ctbl"), rows);
@@ -381,7 +394,7 @@ void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir)
     log::info(msg);
   }
   if (scene.output.write_slices) {
-    const Volume after = deformed_ct_volume(w);
+    const Volume& after = after_ct();
     std::vector<uint8_t> gas(w.result.outcome.size());
     for (std::size_t n = 0; n < gas.size(); ++n) gas[n] = w.result.outcome[n] == WarpOutcome::Gas;
     SliceOverlay overlay;

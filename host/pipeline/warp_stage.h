@@ -99,6 +99,9 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w);
 /// as the scene's output.write_* ask, then adds warp_metrics() to DIR/metrics.json: cavity_voxels
 /// and cavity_volume_ml become the warped cavity's, the mesh's own estimate stays as
 /// mesh_cavity_volume_ml. Every file is written atomically, metrics.json last.
-void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir);
+/// `deformed_ct` and `deformed_labels`, when given, are deformed_ct_volume(w) and
+/// deformed_label_volume(w, …) already built (the run renders them first): not built again.
+void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir, const Volume* deformed_ct = nullptr,
+                const Volume* deformed_labels = nullptr);
 
 }  // namespace pneumo
