@@ -38,8 +38,7 @@ void check_finite_ct(const Volume& ct, const std::string& name) {
 Volume padded_ct_float(const Volume& ct, const PadVoxels& pad) {
   Volume out(padded_geometry(ct.geometry(), pad), VoxelType::Float32);
   dispatch_voxel_type(ct.type(), const_cast<void*>(ct.raw()), [&](auto* src) {
-    const std::vector<float> v = pad_array<float>(src, ct.geometry().dims, pad, -1000.0f);
-    std::copy(v.begin(), v.end(), out.data<float>());
+    pad_into<float>(src, ct.geometry().dims, pad, -1000.0f, out.data<float>());
   });
   return out;
 }
