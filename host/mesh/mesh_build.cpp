@@ -439,6 +439,8 @@ MeshFootprint estimate_mesh_footprint(const VoxelRoles& roles, const MeshOptions
   // towards anything else, wall towards viscera (the cavity's faces among them), bone towards
   // neither bone nor wall (counted whether or not viscera are near: an upper bound).
   const bool with_viscera = opt.model == MeshModel::WallViscera;
+  int64_t fixed_faces = 0, contact_faces = 0, cavity_faces = 0;
+#pragma omp parallel for schedule(static) reduction(+ : fixed_faces, contact_faces, cavity_faces)
   for (int64_t k = 0; k < g.dims[2]; ++k)
     for (int64_t j = 0; j < g.dims[1]; ++j)
       for (int64_t i = 0; i < g.dims[0]; ++i) {
@@ -451,12 +453,15 @@ MeshFootprint estimate_mesh_footprint(const VoxelRoles& roles, const MeshOptions
             n[axis] += side;
             if (n[axis] < 0 || n[axis] >= g.dims[axis]) continue;
             const Role beyond = roles.role[g.linear_index(n[0], n[1], n[2])];
-            if (r == Role::Fixed) fp.fixed_faces += beyond != Role::Fixed && beyond != Role::Wall;
-            else if (r == Role::Viscera) fp.contact_faces += beyond != Role::Viscera;
-            else fp.contact_faces += beyond == Role::Viscera;
-            fp.cavity_faces += (r == Role::Wall && beyond == Role::Viscera) || (r == Role::Viscera && beyond == Role::Wall);
+            if (r == Role::Fixed) fixed_faces += beyond != Role::Fixed && beyond != Role::Wall;
+            else if (r == Role::Viscera) contact_faces += beyond != Role::Viscera;
+            else contact_faces += beyond == Role::Viscera;
+            cavity_faces += (r == Role::Wall && beyond == Role::Viscera) || (r == Role::Viscera && beyond == Role::Wall);
           }
       }
+  fp.fixed_faces += fixed_faces;
+  fp.contact_faces += contact_faces;
+  fp.cavity_faces += cavity_faces;
   // Bytes. Arrays filled by push_back may hold up to twice their size (the growth factor 2); what is
   // gathered per slab and then appended exists in both while it is appended.
   const uint64_t tets = 5 * uint64_t(fp.part_cubes);
