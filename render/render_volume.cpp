@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <stdexcept>
+#include <string>
 
 #include "core/error.h"
 #include "render/transfer_function.h"
@@ -10,10 +12,17 @@
 namespace pneumo {
 
 RenderVolume RenderVolume::from(const Volume& ct, const Volume* labels) {
+  return from_hu(ct.geometry(), ct.to_float32(), labels);
+}
+
+RenderVolume RenderVolume::from_hu(const Geometry& g, std::vector<float> hu, const Volume* labels) {
+  if (int64_t(hu.size()) != g.voxel_count())
+    throw std::invalid_argument("RenderVolume::from_hu: " + std::to_string(hu.size()) + " values for " +
+                                std::to_string(g.voxel_count()) + " voxels");
   RenderVolume v;
-  v.geometry = ct.geometry();
-  v.hu = ct.to_float32();
-  const int64_t n = ct.voxel_count();
+  v.geometry = g;
+  v.hu = std::move(hu);
+  const int64_t n = g.voxel_count();
   bool all_int16 = true;
 #pragma omp parallel for schedule(static) reduction(&& : all_int16)
   for (int64_t i = 0; i < n; ++i) {
@@ -22,7 +31,7 @@ RenderVolume RenderVolume::from(const Volume& ct, const Volume* labels) {
   }
   v.hu_is_int16 = all_int16;
   if (labels) {
-    if (!labels->geometry().same_grid(ct.geometry(), 1e-3))
+    if (!labels->geometry().same_grid(g, 1e-3))
       throw InputError("the label map's voxel grid differs from the CT's; the renderer needs them on one grid");
     v.labels.resize(std::size_t(n));
     // Typed, not through Volume::value: a 0.75 mm CT has 10⁸ voxels. The first bad voxel (lowest

@@ -34,6 +34,9 @@ struct RenderVolume {
   /// From a CT (any voxel type) and an optional label map; InputError when the label map's grid
   /// differs from the CT's or its ids do not fit 16 bits.
   static RenderVolume from(const Volume& ct, const Volume* labels);
+  /// The same from HU already in floats on grid `g` (taken, not copied: a run hands the warp's own),
+  /// and an optional label map on that grid.
+  static RenderVolume from_hu(const Geometry& g, std::vector<float> hu, const Volume* labels);
 
   /// Labels air (HU ≤ threshold) connected to the grid's faces as kExteriorAirLabel (6-connected
   /// flood fill), creating an all-zero label map first when there is none. Exterior views hide it.

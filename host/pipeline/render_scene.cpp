@@ -144,12 +144,17 @@ RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
 RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Volume& ct, const Volume* labels,
                          RenderRun run) {
   fit_threads_to_load();
+  return render_volumes(scene, opt, RenderVolume::from(ct, labels), std::move(run));
+}
+
+RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, RenderVolume volume, RenderRun run) {
+  fit_threads_to_load();
   const auto start = std::chrono::steady_clock::now();
   const ViewSettings& r = scene.render;
   const fs::path out(opt.out_dir);
   const fs::path deformed_labels = out / "deformed_labels.nii.gz";
   const PointMapFn map = opt.map_point ? opt.map_point : identity_point_map();
-  RenderVolume volume = RenderVolume::from(ct, labels);
+  const bool labels = !volume.labels.empty();
   volume.smoothing_mm = r.smoothing_mm;
   const RenderSettings s = settings_from_scene(r, volume.geometry);
 

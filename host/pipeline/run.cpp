@@ -145,7 +145,7 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   solved.displacement_m = displacements(sim.mesh, sim.result.x);
   solved.pressure_pa = sim.result.final_pressure_pa;
   solved.converged = sim.result.converged;
-  const WarpedCase w = warp_solved(scene, std::move(*sim.inputs.ct), std::move(sim.inputs.labels),
+  WarpedCase w = warp_solved(scene, std::move(*sim.inputs.ct), std::move(sim.inputs.labels),
                                    std::move(sim.roles), std::move(sim.mesh), std::move(solved));
   const PointMap point_map = w.point_map();
   const PointMapFn map = deformed_point_fn(point_map);
@@ -174,7 +174,12 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   // not for deflating 10⁸ voxels. A render that fails still leaves the warp's files written.
   RenderRun rendered;
   try {
-    rendered = render_volumes(scene, ro, deformed_ct, deformed_labels ? &*deformed_labels : nullptr, what);
+    // The views take the warp's own HU (rounded as the file holds them), not a float copy of 10⁸ voxels.
+    std::vector<float> hu = std::move(w.result.ct_hu);
+    round_as_written(hu, deformed_ct.type());
+    rendered = render_volumes(
+        scene, ro, RenderVolume::from_hu(deformed_ct.geometry(), std::move(hu), deformed_labels ? &*deformed_labels : nullptr),
+        what);
   } catch (...) {
     write_warp(scene, w, o.out_dir, &deformed_ct, deformed_labels ? &*deformed_labels : nullptr);
     throw;

@@ -225,6 +225,21 @@ Volume deformed_ct_volume(const WarpedCase& w) {
   return v;
 }
 
+void round_as_written(std::vector<float>& hu, VoxelType written) {
+  dispatch_voxel_type(written, nullptr, [&](auto* p) {
+    using T = std::remove_pointer_t<decltype(p)>;
+    if constexpr (std::is_integral_v<T>) {
+      const double lo = double(std::numeric_limits<T>::lowest()), hi = double(std::numeric_limits<T>::max());
+      const int64_t count = int64_t(hu.size());
+#pragma omp parallel for schedule(static)
+      for (int64_t n = 0; n < count; ++n) {
+        float& x = hu[std::size_t(n)];
+        x = float(T(std::clamp(std::nearbyint(double(x)), lo, hi)));
+      }
+    }
+  });
+}
+
 std::map<int, std::string> scene_label_names(const Scene& scene) {
   if (scene.inputs.label_names.empty()) return {};
   return read_label_names(scene.inputs.label_names);
@@ -282,7 +297,8 @@ Volume deformed_label_volume(const WarpedCase& w, int cavity_label) {
 }
 
 nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
-  const double mvox_s = w.seconds_warp > 0 ? double(w.result.ct_hu.size()) / w.seconds_warp / 1e6 : 0.0;
+  // The outcomes, not the HU: a run hands the HU to the renderer before the metrics are written.
+  const double mvox_s = w.seconds_warp > 0 ? double(w.result.outcome.size()) / w.seconds_warp / 1e6 : 0.0;
   nlohmann::json j;
   j["deformed_body_outside_grid_mm"] = w.outside_grid_mm;
   j["cavity_voxels"] = w.cavity_voxels();

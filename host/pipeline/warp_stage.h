@@ -79,6 +79,9 @@ WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labe
 /// The deformed CT in the input's voxel type where it can hold HU (int16, int32 rounded to the
 /// nearest HU; float32, float64 as computed), float32 otherwise (unsigned or 8-bit types).
 Volume deformed_ct_volume(const WarpedCase& w);
+/// The warp's HU as deformed_ct_volume writes them, in floats: rounded in place to the nearest HU
+/// and clamped where `written` (deformed_ct_volume's type) is an integer type, as they are.
+void round_as_written(std::vector<float>& hu, VoxelType written);
 /// The scene's inputs.label_names (io/label_table.h), empty when unset: read before any long work so
 /// that a bad file is refused at once.
 std::map<int, std::string> scene_label_names(const Scene& scene);

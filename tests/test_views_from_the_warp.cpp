@@ -1,0 +1,60 @@
+// `pneumo run` hands the warp's own HU to the views (round_as_written, RenderVolume::from_hu)
+// instead of converting the written deformed CT back to floats: the renderer's volume must be the
+// one it would read from that file, value for value, for every voxel type the CT is written in.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <stdexcept>
+
+#include "pipeline/warp_stage.h"
+#include "render/render_volume.h"
+
+namespace pneumo {
+namespace {
+
+TEST(ViewsFromTheWarp, TheWarpsHuRoundedAsWrittenAreTheWrittenCtsHu) {
+  Geometry g;
+  g.dims = {9, 7, 5};
+  g.spacing_mm = Vec3(0.75, 0.75, 1.5);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> hu(-1200.0f, 3000.0f);
+  std::vector<float> warped(std::size_t(g.voxel_count()));
+  for (float& x : warped) x = hu(rng);
+  // Ties, whole values, and values beyond 16 and 32 bits, which the written types clamp.
+  warped[0] = 10.5f, warped[1] = -10.5f, warped[2] = 40000.0f, warped[3] = -40000.0f, warped[4] = 3e10f, warped[5] = 17.0f;
+  for (const VoxelType input : {VoxelType::Int16, VoxelType::Int32, VoxelType::Float32, VoxelType::Float64, VoxelType::UInt8}) {
+    WarpedCase w;
+    w.ct = Volume(g, input);
+    w.output_grid = g;
+    w.result.ct_hu = warped;
+    const Volume written = deformed_ct_volume(w);
+    const RenderVolume from_file = RenderVolume::from(written, nullptr);
+    std::vector<float> taken = warped;
+    round_as_written(taken, written.type());
+    const RenderVolume from_warp = RenderVolume::from_hu(g, std::move(taken), nullptr);
+    ASSERT_EQ(from_warp.hu.size(), from_file.hu.size());
+    for (std::size_t n = 0; n < warped.size(); ++n)
+      ASSERT_EQ(from_warp.hu[n], from_file.hu[n]) << "voxel " << n << ", input type " << int(input);
+    EXPECT_EQ(from_warp.hu_is_int16, from_file.hu_is_int16) << int(input);
+    EXPECT_EQ(from_warp.geometry.dims, g.dims);
+  }
+  // Rounded to the nearest (ties to even) and clamped to 16 bits, as the file holds them.
+  std::vector<float> int16 = warped;
+  round_as_written(int16, VoxelType::Int16);
+  EXPECT_EQ(int16[0], 10.0f);
+  EXPECT_EQ(int16[1], -10.0f);
+  EXPECT_EQ(int16[2], 32767.0f);
+  EXPECT_EQ(int16[3], -32768.0f);
+  EXPECT_FALSE(RenderVolume::from_hu(g, int16, nullptr).hu_is_int16);   // −32768 has no snorm16 value
+  int16[3] = -1000.0f;
+  EXPECT_TRUE(RenderVolume::from_hu(g, int16, nullptr).hu_is_int16);
+}
+
+TEST(ViewsFromTheWarp, ValuesForAnotherGridAreRefused) {
+  Geometry g;
+  g.dims = {4, 4, 4};
+  EXPECT_THROW(RenderVolume::from_hu(g, std::vector<float>(63), nullptr), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pneumo
