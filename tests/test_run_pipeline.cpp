@@ -18,6 +18,7 @@
 #include "pipeline/simulate.h"
 #include "scene/scene.h"
 #include "shared_data.h"
+#include "core/error.h"
 
 using namespace pneumo;
 using testing_support::ScratchDir;
@@ -116,6 +117,25 @@ TEST(RunPipeline, SmallPhantomEndToEnd) {
   const std::string html((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
   EXPECT_EQ(testing_support::count_occurrences(html, "data:image/png;base64,"), 6);   // the roles, the slices and the 4 views
   EXPECT_NE(html.find("<svg"), std::string::npos);
+}
+
+TEST(RunPipeline, ARenderThatFailsStillLeavesTheWarpsFiles) {
+  // The run renders its views before writing the warp's files (the first view sooner); a render that
+  // fails must still leave the solve's and the warp's results on disk, as when the files came first.
+  ScratchDir dir;
+  Scene scene = small_phantom(dir);
+  ASSERT_FALSE(scene.render.cameras.empty());
+  scene.render.cameras[0].position_mm = Vec3(0.0, 5000.0, 0.0);   // 5 m in front of the body
+  RunOptions o;
+  o.out_dir = dir.file("run");
+  EXPECT_THROW(run_pipeline(scene, o), InputError);
+  const fs::path out(o.out_dir);
+  for (const char* f : {"deformation.bin", "deformed_ct.nii.gz", "deformed_labels.nii.gz", "slices_before_after.png"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  const nlohmann::json m = read_json(out / "metrics.json");
+  EXPECT_TRUE(m.contains("warp"));
+  EXPECT_GT(m.at("cavity_volume_ml").get<double>(), 0.0);
+  EXPECT_FALSE(m.contains("pipeline_complete"));
 }
 
 TEST(RunPipeline, AnEarlierRunIsNotOverwrittenWithoutForce) {
