@@ -394,12 +394,18 @@ std::vector<uint8_t> meshed_parts(const VoxelRoles& roles, const Lattice& lat, c
   const int L = opt.cube_voxels;
   const bool with_viscera = opt.model == MeshModel::WallViscera;
   std::vector<uint8_t> meshed(std::size_t(lat.cubes[0] * lat.cubes[1] * lat.cubes[2]), 0);
-  for (int64_t k = 0; k < g.dims[2]; ++k)
-    for (int64_t j = 0; j < g.dims[1]; ++j)
-      for (int64_t i = 0; i < g.dims[0]; ++i) {
-        const Role r = roles.role[g.linear_index(i, j, k)];
-        if (r == Role::Wall || (with_viscera && r == Role::Viscera))
-          meshed[lat.cube_index(i / L, j / L, k / L)] |= r == Role::Wall ? 1 : 2;
+  // One layer of cubes per iteration: each thread writes only its own layers' cubes.
+#pragma omp parallel for schedule(static)
+  for (int64_t c = 0; c < lat.cubes[2]; ++c)
+    for (int64_t k = c * L; k < std::min<int64_t>((c + 1) * L, g.dims[2]); ++k)
+      for (int64_t j = 0; j < g.dims[1]; ++j) {
+        const Role* row = roles.role + g.linear_index(0, j, k);
+        uint8_t* cube_row = meshed.data() + lat.cube_index(0, j / L, c);
+        for (int64_t a = 0; a < lat.cubes[0]; ++a)
+          for (int64_t i = a * L; i < std::min<int64_t>((a + 1) * L, g.dims[0]); ++i) {
+            const Role r = row[i];
+            if (r == Role::Wall || (with_viscera && r == Role::Viscera)) cube_row[a] |= r == Role::Wall ? 1 : 2;
+          }
       }
   if (opt.roi_min_mm && opt.roi_max_mm)
     for (int64_t c = 0; c < lat.cubes[2]; ++c)
