@@ -1,11 +1,14 @@
 // The parallel gzip writer (io/gzip_members.h) against zlib, the reader niftilib, ITK and VTK use:
 // what it writes inflates to exactly the bytes given, as one member per piece of at most
 // kGzipMemberBytes (each a whole gzip stream with its own CRC and length, RFC 1952), whatever the
-// thread count; and a full disk is an error, not a short file.
+// thread count; and a full disk is an error, not a short file. The parallel reader
+// (inflate_gzip_members) gives back exactly those bytes, and declines every other file: zlib's own
+// single stream, a truncated or corrupted copy, a range that starts inside a member.
 #include <gtest/gtest.h>
 #include <omp.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -95,6 +98,61 @@ TEST(GzipMembers, AnEmptyPartIsAnEmptyMember) {
   EXPECT_TRUE(in.clean);
   EXPECT_EQ(in.members, 2);
   EXPECT_EQ(in.bytes, (std::vector<unsigned char>{1, 2, 3}));
+}
+
+namespace {
+std::string write_file(const std::string& name, const std::vector<unsigned char>& bytes) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  EXPECT_NE(f, nullptr);
+  std::fwrite(bytes.data(), 1, bytes.size(), f);
+  std::fclose(f);
+  return path;
+}
+}  // namespace
+
+TEST(GzipMembers, ReadBackOnEveryCoreExactlyAndOnlyTheirOwnLayout) {
+  // A 352-byte header member, then 2.5 members of noisy int16.
+  std::vector<int16_t> voxels(std::size_t(kGzipMemberBytes * 5 / 2 / sizeof(int16_t)));
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.0f, 30.0f);
+  for (auto& v : voxels) v = int16_t(noise(rng));
+  std::vector<unsigned char> head(352, 7);
+  const uint64_t payload = voxels.size() * sizeof(int16_t);
+  const std::vector<unsigned char> gz = written({{head.data(), head.size()}, {voxels.data(), payload}}, 2);
+  const std::string path = write_file("members_read.gz", gz);
+
+  std::vector<int16_t> back(voxels.size(), 0);
+  for (int threads : {1, 2, 3}) {
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(threads);
+    std::fill(back.begin(), back.end(), int16_t(0));
+    EXPECT_TRUE(inflate_gzip_members(path, head.size(), payload, back.data())) << threads << " threads";
+    omp_set_num_threads(saved);
+    EXPECT_TRUE(back == voxels) << threads << " threads";
+  }
+  std::vector<unsigned char> all(head.size() + payload);
+  EXPECT_TRUE(inflate_gzip_members(path, 0, all.size(), all.data()));
+  EXPECT_TRUE(std::equal(head.begin(), head.end(), all.begin()));
+
+  // Not a member boundary, or not the whole file: declined.
+  EXPECT_FALSE(inflate_gzip_members(path, 100, head.size() + payload - 100, all.data()));
+  EXPECT_FALSE(inflate_gzip_members(path, head.size(), payload - 2, back.data()));
+  // Truncated by one byte, or one byte of deflate data changed: declined.
+  std::vector<unsigned char> cut(gz.begin(), gz.end() - 1);
+  EXPECT_FALSE(inflate_gzip_members(write_file("members_cut.gz", cut), head.size(), payload, back.data()));
+  std::vector<unsigned char> bent = gz;
+  bent[bent.size() / 2] ^= 0x40;
+  EXPECT_FALSE(inflate_gzip_members(write_file("members_bent.gz", bent), head.size(), payload, back.data()));
+  // zlib's own gzip (one member, no lengths in its header): declined, for the stream reader.
+  const std::string plain = ::testing::TempDir() + "/zlib_plain.gz";
+  gzFile z = gzopen(plain.c_str(), "wb1");
+  ASSERT_NE(z, nullptr);
+  gzwrite(z, head.data(), unsigned(head.size()));
+  gzwrite(z, voxels.data(), unsigned(payload));
+  gzclose(z);
+  EXPECT_FALSE(inflate_gzip_members(plain, head.size(), payload, back.data()));
+  EXPECT_FALSE(inflate_gzip_members(::testing::TempDir() + "/no_such_file.gz", 0, 1, back.data()));
 }
 
 TEST(GzipMembers, AFullDiskIsAnError) {

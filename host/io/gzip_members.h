@@ -6,6 +6,12 @@
 // libdeflate (whole-buffer, faster than zlib at the same ratio; Debian's libdeflate-dev), on as many
 // threads as OpenMP gives, and the members are written in order. A member costs 18 bytes of header
 // and trailer and restarts the 32 KiB window: under 0.1 % of a CT's compressed size.
+//
+// Each member's header carries its own length in an extra field (RFC 1952 §2.3.1.1, FEXTRA; subfield
+// 'P','M', 4 bytes little-endian: the member's bytes from its first header byte to the end of its
+// trailer), as htslib's BGZF does for its blocks. Readers that do not know the subfield skip it. A
+// reader that does can find every member without inflating the ones before it, and so inflate them
+// all at once (inflate_gzip_members).
 #include <cstdint>
 #include <cstdio>
 #include <string>
@@ -28,5 +34,13 @@ struct ByteSpan {
 /// members of at most kGzipMemberBytes. Throws std::runtime_error naming `path` when a write fails
 /// (a full disk) or libdeflate cannot start.
 void write_gzip_members(std::FILE* f, const std::string& path, const std::vector<ByteSpan>& parts, int level);
+
+/// Bytes [offset, offset + bytes) of what the gzip file at `path` inflates to, into `dst`, with the
+/// members inflated side by side on every thread (libdeflate, each member's CRC-32 and length
+/// checked). Only for files in write_gzip_members' layout: every member carrying its length, one
+/// starting exactly at `offset`, and the whole inflating to exactly offset + bytes. Returns false,
+/// having read nothing it vouches for, for anything else (another writer's file, a truncated or
+/// corrupt one): the caller then reads the file as a stream and reports what is wrong.
+bool inflate_gzip_members(const std::string& path, uint64_t offset, uint64_t bytes, void* dst);
 
 }  // namespace pneumo

@@ -220,6 +220,9 @@ Geometry geometry_from_nim(const std::string& path, const nifti_image& nim) {
 }
 
 void read_payload(const std::string& path, uint64_t offset, uint64_t payload, void* dst) {
+  // pneumo's own .nii.gz (gzip members that carry their lengths) inflate on every core; any other
+  // file, or one of ours that is truncated or corrupt, is read as a stream, which says what is wrong.
+  if (is_gz(path) && inflate_gzip_members(path, offset, payload, dst)) return;
   GzPtr f = open_for_reading(path);
   if (gzseek(f.get(), static_cast<z_off_t>(offset), SEEK_SET) < 0)
     throw file_error(path, "truncated: no voxel data at offset " + std::to_string(offset));
