@@ -125,26 +125,29 @@ std::vector<float> gaussian_filter(const float* src, const Index3& d, const Vec3
   {  // along i: src → along_i (mx per row)
     const std::vector<float> w = gaussian_taps(sigma[0]);
     const int64_t R = int64_t(w.size() / 2), f = stride[0];
+    // With stride f the padded line is dealt into f phases, phase p holding line[f·m + p]: output i
+    // then reads tap r at phase r mod f, index i + r div f, so every tap is a contiguous row again
+    // and the kept outputs go through weighted_rows like the full-resolution ones.
+    const int64_t padded = nx + 2 * R, phase_length = (padded + f - 1) / f;
 #pragma omp parallel
     {
-      std::vector<float> line(std::size_t(nx + 2 * R));
+      std::vector<float> line(static_cast<std::size_t>(padded));
+      std::vector<float> phases(f == 1 ? 0 : std::size_t(f * phase_length));
       std::vector<const float*> rows(w.size());
+      if (f == 1)
+        for (std::size_t r = 0; r < w.size(); ++r) rows[r] = line.data() + r;
+      else
+        for (std::size_t r = 0; r < w.size(); ++r)
+          rows[r] = phases.data() + (int64_t(r) % f) * phase_length + int64_t(r) / f;
 #pragma omp for schedule(static)
       for (int64_t q = 0; q < ny * nz; ++q) {
         const float* in = src + q * nx;
         for (int64_t t = -R; t < nx + R; ++t) line[std::size_t(t + R)] = in[std::clamp<int64_t>(t, 0, nx - 1)];
-        float* out = along_i.data() + q * mx;
-        if (f == 1) {
-          for (std::size_t r = 0; r < w.size(); ++r) rows[r] = line.data() + r;
-          weighted_rows(out, rows, w, nx);
-        } else {
-          for (int64_t i = 0; i < mx; ++i) {
-            const float* x = line.data() + f * i;
-            float sum = 0.0f;
-            for (std::size_t r = 0; r < w.size(); ++r) sum += w[r] * x[r];
-            out[i] = sum;
-          }
+        for (int64_t p = 0; f > 1 && p < f; ++p) {
+          float* phase = phases.data() + p * phase_length;
+          for (int64_t m = 0, t = p; t < padded; ++m, t += f) phase[m] = line[std::size_t(t)];
         }
+        weighted_rows(along_i.data() + q * mx, rows, w, mx);
       }
     }
   }
