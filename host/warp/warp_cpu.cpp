@@ -14,6 +14,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <exception>
@@ -374,46 +375,43 @@ void warp_cpu(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, c
   const int64_t T = mesh.tet_count();
   out.device = "cpu";
   out.carried_voxels = out.gas_voxels = out.kept_voxels = 0;
-  // Outputs of another size are released and allocated anew: their hundreds of MB are faulted in on a
-  // thread of their own while the tetrahedra are prepared, each waiting on memory, not on the other.
-  // Every voxel is written below (its outcome reset tile by tile), so outputs of this size are reused
-  // as they are.
+  // Outputs of another size are released and allocated anew, faulted in on two threads of their own
+  // while the tetrahedra are prepared: the kernel zeroes each page as it is first touched, at a few
+  // hundred MB/s a core on a VM, so the HU (4 bytes a voxel) go on one and labels and outcomes (3
+  // bytes) on the other. Every voxel is written below (its outcome reset tile by tile), so outputs of
+  // this size are reused as they are.
   const std::size_t n_out = std::size_t(box.voxel_count());
   const std::size_t n_labels = src.labels ? n_out : 0;
   const bool allocating = out.ct_hu.size() != n_out || out.labels.size() != n_labels || out.outcome.size() != n_out;
-  std::exception_ptr allocate_failed;   // bad_alloc, rethrown here after the join
-  std::thread allocate;
+  std::array<std::exception_ptr, 2> allocate_failed;   // bad_alloc, rethrown here after the joins
+  std::array<std::thread, 2> allocate;
   if (allocating) {
     // Released before the new ones are allocated (assigning {} would keep the capacity).
     std::vector<float>().swap(out.ct_hu);
     std::vector<uint16_t>().swap(out.labels);
     std::vector<WarpOutcome>().swap(out.outcome);
-    // Two threads: the kernel zeroes each page as it is first touched, at a few hundred MB/s a
-    // core on a VM, so the HU (4 bytes a voxel) on one and labels and outcomes (3 bytes) on the other.
-    allocate = std::thread([&] {
-      std::exception_ptr labels_failed;
-      std::thread labels_and_outcomes([&] {
+    auto start = [&](int n, auto resize) {
+      allocate[n] = std::thread([&allocate_failed, n, resize] {
         try {
-          out.labels.resize(n_labels);
-          out.outcome.resize(n_out);
+          resize();
         } catch (...) {
-          labels_failed = std::current_exception();
+          allocate_failed[n] = std::current_exception();
         }
       });
-      try {
-        out.ct_hu.resize(n_out);
-      } catch (...) {
-        allocate_failed = std::current_exception();
-      }
-      labels_and_outcomes.join();
-      if (!allocate_failed) allocate_failed = labels_failed;
+    };
+    start(0, [&] { out.ct_hu.resize(n_out); });
+    start(1, [&] {
+      out.labels.resize(n_labels);
+      out.outcome.resize(n_out);
     });
   }
   struct JoinOnExit {   // also when preparing throws: a joinable thread's destructor would terminate
-    std::thread& t;
-    ~JoinOnExit() {
-      if (t.joinable()) t.join();
+    std::array<std::thread, 2>& threads;
+    void join() {
+      for (std::thread& t : threads)
+        if (t.joinable()) t.join();
     }
+    ~JoinOnExit() { join(); }
   } join_allocate{allocate};
   const CubeOrder order = cube_order(mesh);
   timer.lap("order");
@@ -439,8 +437,9 @@ void warp_cpu(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, c
   }
 
   timer.lap("tiles");
-  if (allocate.joinable()) allocate.join();
-  if (allocate_failed) std::rethrow_exception(allocate_failed);
+  join_allocate.join();
+  for (const std::exception_ptr& e : allocate_failed)
+    if (e) std::rethrow_exception(e);
   const SourceGrid grid{mesh.grid.dims, src.ct_hu, src.labels, src.roles};
 
   const int64_t nx = box.dims[0], ny = box.dims[1];
