@@ -70,16 +70,23 @@ std::optional<Vec3> cavity_centroid(const WarpResult& r, const Geometry& g) {
   return g.to_world(sum / double(n));
 }
 
+/// One warped HU as the deformed CT of type T holds it: to the nearest HU and clamped for integer
+/// types (deformed_ct_volume), as computed for floating ones. round_as_written applies the same.
+template <class T>
+T as_written(float hu) {
+  if constexpr (std::is_integral_v<T>)
+    return T(std::clamp(std::nearbyint(double(hu)), double(std::numeric_limits<T>::lowest()),
+                        double(std::numeric_limits<T>::max())));
+  else
+    return T(hu);
+}
+
 template <class T>
 void fill_rounded(Volume& v, const std::vector<float>& hu) {
   T* out = v.data<T>();
-  const double lo = double(std::numeric_limits<T>::lowest()), hi = double(std::numeric_limits<T>::max());
   const int64_t count = int64_t(hu.size());
 #pragma omp parallel for schedule(static)
-  for (int64_t n = 0; n < count; ++n) {
-    if constexpr (std::is_integral_v<T>) out[n] = T(std::clamp(std::nearbyint(double(hu[std::size_t(n)])), lo, hi));
-    else out[n] = T(hu[std::size_t(n)]);
-  }
+  for (int64_t n = 0; n < count; ++n) out[n] = as_written<T>(hu[std::size_t(n)]);
 }
 
 /// Grows the working grid (roles and warp mesh together) wherever the deformed body leaves it, by
@@ -228,14 +235,10 @@ Volume deformed_ct_volume(const WarpedCase& w) {
 void round_as_written(std::vector<float>& hu, VoxelType written) {
   dispatch_voxel_type(written, nullptr, [&](auto* p) {
     using T = std::remove_pointer_t<decltype(p)>;
-    if constexpr (std::is_integral_v<T>) {
-      const double lo = double(std::numeric_limits<T>::lowest()), hi = double(std::numeric_limits<T>::max());
+    if constexpr (std::is_integral_v<T>) {   // floating types hold the values as they are
       const int64_t count = int64_t(hu.size());
 #pragma omp parallel for schedule(static)
-      for (int64_t n = 0; n < count; ++n) {
-        float& x = hu[std::size_t(n)];
-        x = float(T(std::clamp(std::nearbyint(double(x)), lo, hi)));
-      }
+      for (int64_t n = 0; n < count; ++n) hu[std::size_t(n)] = float(as_written<T>(hu[std::size_t(n)]));
     }
   });
 }
@@ -316,8 +319,8 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
         w.cavity_voxels() > 0 ? 1.0 - double(largest) / double(w.cavity_voxels()) : 0.0;
     // Gas in front of the extraperitoneal organs the roles keep attached (the bladder), in the
     // deformed frame: all of it; the part with no intraperitoneal organ between it and the bladder;
-    // and of that, the part in front of bladder that no intraperitoneal organ covered at rest (the
-    // space of Retzius, where none should open; cavity_measures.h).
+    // and of that, the part on tissue that no intraperitoneal organ covered at rest (the space of
+    // Retzius, where none should open; cavity_measures.h).
     if (!scene.roles.auto_prevesical_labels.empty()) {
       const uint16_t gas_id = uint16_t(scene.output.cavity_label);
       const auto& bladder = scene.roles.auto_prevesical_labels;
@@ -336,7 +339,7 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
           const MappedPoint p = map.to_original(deformed_mm);
           return p.carried ? std::optional<Vec3>(p.point_mm) : std::nullopt;
         };
-        prevesical = gas_voxels_in_prevesical_space(w.result.labels, w.output_grid, gas_id, bladder, organs, rest);
+        prevesical = gas_voxels_anterior_to(w.result.labels, w.output_grid, gas_id, bladder, organs, &rest);
       }
       j["gas_in_prevesical_space_ml"] = double(prevesical) * w.voxel_volume_ml;
     }
