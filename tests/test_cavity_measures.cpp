@@ -85,23 +85,23 @@ TEST(CavityMeasures, GasOnTissueThatABowelLoopCoveredAtRestIsPeritoneal) {
     rest.labels = rest_labels.data();
     rest.grid = c.g;
     rest.to_rest = [](const Vec3& p) { return std::optional<Vec3>(p); };   // nothing moved
-    EXPECT_EQ(gas_voxels_in_prevesical_space(c.labels, c.g, kGas, {kBladder}, {kBowel}, rest), 2);
+    EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {kBladder}, {kBowel}, &rest), 2);
 
     // The bowel lay on the floor's cranial face: peritoneal.
     rest_at(rest_labels, 1, 4, 1) = kBowel;
-    EXPECT_EQ(gas_voxels_in_prevesical_space(c.labels, c.g, kGas, {kBladder}, {kBowel}, rest), 0);
+    EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {kBladder}, {kBowel}, &rest), 0);
     // …but two voxels away from it, in front of the gas, it covered nothing under the gas.
     rest_at(rest_labels, 1, 4, 1) = 0;
     rest_at(rest_labels, 1, 6, 1) = kBowel;
-    EXPECT_EQ(gas_voxels_in_prevesical_space(c.labels, c.g, kGas, {kBladder}, {kBowel}, rest), 2);
+    EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {kBladder}, {kBowel}, &rest), 2);
 
     // The floor is traced: where it came from two voxels further forward, the bowel touched it.
     const Vec3 forward = c.g.to_world(Vec3(0, flipped ? -2 : 2, 0)) - c.g.to_world(Vec3(0, 0, 0));
     rest.to_rest = [forward](const Vec3& p) { return std::optional<Vec3>(p + forward); };
-    EXPECT_EQ(gas_voxels_in_prevesical_space(c.labels, c.g, kGas, {kBladder}, {kBowel}, rest), 0);
+    EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {kBladder}, {kBowel}, &rest), 0);
     // A floor that no tetrahedron carries counts.
     rest.to_rest = [](const Vec3&) { return std::optional<Vec3>(); };
-    EXPECT_EQ(gas_voxels_in_prevesical_space(c.labels, c.g, kGas, {kBladder}, {kBowel}, rest), 2);
+    EXPECT_EQ(gas_voxels_anterior_to(c.labels, c.g, kGas, {kBladder}, {kBowel}, &rest), 2);
   }
 }
 

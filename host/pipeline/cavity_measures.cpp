@@ -50,22 +50,8 @@ bool touched_an_organ_at_rest(const RestColumns& rest, const Vec3& rest_mm, cons
 }  // namespace
 
 int64_t gas_voxels_anterior_to(const std::vector<uint16_t>& labels, const Geometry& g, uint16_t gas_label,
-                               const std::vector<int>& ids, const std::vector<int>& stop_ids) {
-  const SliceFrame f = slice_frame(g);
-  const std::vector<int64_t> fronts = front_of_labels(labels.data(), f, LabelSet(ids));
-  const LabelSet stop(stop_ids);
-  int64_t count = 0;
-  for (int64_t s = 0; s < f.n_si; ++s)
-    for (int64_t l = 0; l < f.n_lat; ++l) {
-      const int64_t front = fronts[std::size_t(s * f.n_lat + l)];
-      if (front >= 0) count += gas_in_front(labels, f, l, s, front, gas_label, stop).voxels;
-    }
-  return count;
-}
-
-int64_t gas_voxels_in_prevesical_space(const std::vector<uint16_t>& labels, const Geometry& g, uint16_t gas_label,
-                                       const std::vector<int>& ids, const std::vector<int>& stop_ids,
-                                       const RestColumns& rest) {
+                               const std::vector<int>& ids, const std::vector<int>& stop_ids,
+                               const RestColumns* rest) {
   const SliceFrame f = slice_frame(g);
   const std::vector<int64_t> fronts = front_of_labels(labels.data(), f, LabelSet(ids));
   const LabelSet stop(stop_ids);
@@ -76,15 +62,16 @@ int64_t gas_voxels_in_prevesical_space(const std::vector<uint16_t>& labels, cons
       if (front < 0) continue;
       const GasInFront gas = gas_in_front(labels, f, l, s, front, gas_label, stop);
       if (gas.voxels == 0) continue;
-      // The floor: the voxel behind the column's first gas voxel (tissue, or the organ itself).
-      int64_t along[3];
-      along[f.lat] = l;
-      along[f.ap] = f.ant(gas.first - 1);
-      along[f.si] = s;
-      const std::optional<Vec3> floor_at_rest =
-          rest.to_rest ? rest.to_rest(g.to_world(Vec3(double(along[0]), double(along[1]), double(along[2]))))
-                       : std::nullopt;
-      if (floor_at_rest && rest.labels && touched_an_organ_at_rest(rest, *floor_at_rest, stop)) continue;
+      if (rest && rest->to_rest && rest->labels) {
+        // The floor: the voxel behind the column's first gas voxel (tissue, or the organ itself).
+        int64_t along[3];
+        along[f.lat] = l;
+        along[f.ap] = f.ant(gas.first - 1);
+        along[f.si] = s;
+        const std::optional<Vec3> floor_at_rest =
+            rest->to_rest(g.to_world(Vec3(double(along[0]), double(along[1]), double(along[2]))));
+        if (floor_at_rest && touched_an_organ_at_rest(*rest, *floor_at_rest, stop)) continue;
+      }
       count += gas.voxels;
     }
   return count;
