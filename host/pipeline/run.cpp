@@ -170,6 +170,7 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
     deformed_labels = deformed_label_volume(w, scene.output.cavity_label);
     what.labels_path = (out / "deformed_labels.nii.gz").string();
   }
+  const Volume* const labels_out = deformed_labels ? &*deformed_labels : nullptr;
   // The views first, from memory, and the warp's files after them: a user waits for the first view,
   // not for deflating 10⁸ voxels. A render that fails still leaves the warp's files written.
   RenderRun rendered;
@@ -177,16 +178,14 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
     // The views take the warp's own HU (rounded as the file holds them), not a float copy of 10⁸ voxels.
     std::vector<float> hu = std::move(w.result.ct_hu);
     round_as_written(hu, deformed_ct.type());
-    rendered = render_volumes(
-        scene, ro, RenderVolume::from_hu(deformed_ct.geometry(), std::move(hu), deformed_labels ? &*deformed_labels : nullptr),
-        what);
+    rendered = render_volumes(scene, ro, RenderVolume::from_hu(deformed_ct.geometry(), std::move(hu), labels_out), what);
   } catch (...) {
-    write_warp(scene, w, o.out_dir, &deformed_ct, deformed_labels ? &*deformed_labels : nullptr);
+    write_warp(scene, w, o.out_dir, &deformed_ct, labels_out);
     throw;
   }
   const double seconds_render = seconds_since(t_render);
   log::info("writing the warped CT and labels");
-  write_warp(scene, w, o.out_dir, &deformed_ct, deformed_labels ? &*deformed_labels : nullptr);
+  write_warp(scene, w, o.out_dir, &deformed_ct, labels_out);
 
   // Report: landmarks, plots, metrics (complete), report.html last.
   log::info("stage 4/4: report");
