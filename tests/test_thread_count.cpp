@@ -1,6 +1,9 @@
 // The thread count fitted to the machine's load (core/thread_count.h): the cores left from the
-// kernel's count of runnable tasks, and reading that count from /proc/loadavg's line.
+// kernel's count of runnable tasks less this process's own, and reading both from /proc.
 #include <gtest/gtest.h>
+
+#include <atomic>
+#include <thread>
 
 #include "core/error.h"
 #include "core/thread_count.h"
@@ -9,17 +12,42 @@ namespace pneumo {
 namespace {
 
 TEST(ThreadCount, CoresLeftAreTheUsableLessTheOtherRunningTasks) {
-  // Each sample counts the sampling thread itself: 1 means nobody else runs.
-  EXPECT_EQ(cores_left(2, {1, 1, 1, 1, 1}), 2);
-  EXPECT_EQ(cores_left(2, {2, 2, 2, 2, 2}), 1);     // one busy process beside us
-  EXPECT_EQ(cores_left(8, {4, 4, 4, 4, 4}), 5);
-  EXPECT_EQ(cores_left(2, {5, 5, 5, 5, 5}), 1);     // never fewer than one
-  EXPECT_EQ(cores_left(4, {0, 0, 0, 0, 0}), 4);     // never more than usable
+  // Each sample counts the runnable tasks of other processes: 0 means nobody else runs.
+  EXPECT_EQ(cores_left(2, {0, 0, 0, 0, 0}), 2);
+  EXPECT_EQ(cores_left(2, {1, 1, 1, 1, 1}), 1);     // one busy process beside us
+  EXPECT_EQ(cores_left(8, {3, 3, 3, 3, 3}), 5);
+  EXPECT_EQ(cores_left(2, {4, 4, 4, 4, 4}), 1);     // never fewer than one
+  EXPECT_EQ(cores_left(4, {-1, -1, 0, 0, 0}), 4);   // never more than usable
   // The median: a passing kernel thread or a short burst in one sample does not move it.
-  EXPECT_EQ(cores_left(2, {1, 3, 1, 1, 2}), 2);
-  EXPECT_EQ(cores_left(4, {3, 1, 3, 3, 9}), 2);
+  EXPECT_EQ(cores_left(2, {0, 2, 0, 0, 1}), 2);
+  EXPECT_EQ(cores_left(4, {2, 0, 2, 2, 8}), 2);
   EXPECT_EQ(cores_left(3, {}), 3);                  // nothing read: every usable core
-  EXPECT_EQ(cores_left(0, {1}), 1);
+  EXPECT_EQ(cores_left(0, {0}), 1);
+}
+
+TEST(ThreadCount, TaskStateIsTheLetterAfterTheName) {
+  EXPECT_EQ(task_state("4242 (pneumo) R 1 4242 0"), 'R');
+  EXPECT_EQ(task_state("4243 (omp worker) S 1 4242 0"), 'S');
+  EXPECT_EQ(task_state("4244 (a) b) D 1"), 'D');   // a name may hold ") " itself: the last ')' ends it
+  EXPECT_EQ(task_state("4245 (pneumo)"), '?');
+  EXPECT_EQ(task_state(""), '?');
+}
+
+TEST(ThreadCount, OurOwnSpinningThreadIsNotAnotherProcess) {
+  // A thread of ours that spins, as OpenMP's workers do after a loop, is runnable all the while;
+  // own_runnable_threads() must see it beside the caller, so that fit_threads_to_load takes it off.
+  std::atomic<bool> started{false}, stop{false};
+  std::thread spinner([&] {
+    started = true;
+    while (!stop.load(std::memory_order_relaxed)) {
+    }
+  });
+  while (!started) std::this_thread::yield();
+  const int own = own_runnable_threads();
+  stop = true;
+  spinner.join();
+  EXPECT_GE(own, 2);
+  EXPECT_GE(own_runnable_threads(), 1);   // the caller itself
 }
 
 TEST(ThreadCount, RunnableTasksAreTheFourthFieldOfLoadavg) {

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <string>
 #include <thread>
 
@@ -31,12 +33,12 @@ void set_thread_count(int threads) {
   log::debug("CPU threads: " + n + " (OpenMP loops and PoCL's CPU device)");
 }
 
-int cores_left(int usable, std::vector<int> runnable_samples) {
+int cores_left(int usable, std::vector<int> others_samples) {
   usable = std::max(usable, 1);
-  if (runnable_samples.empty()) return usable;
-  std::nth_element(runnable_samples.begin(), runnable_samples.begin() + runnable_samples.size() / 2,
-                   runnable_samples.end());
-  const int others = std::max(runnable_samples[runnable_samples.size() / 2] - 1, 0);
+  if (others_samples.empty()) return usable;
+  std::nth_element(others_samples.begin(), others_samples.begin() + others_samples.size() / 2,
+                   others_samples.end());
+  const int others = std::max(others_samples[others_samples.size() / 2], 0);
   return std::clamp(usable - others, 1, usable);
 }
 
@@ -45,6 +47,26 @@ int runnable_tasks(const char* line) {
   int running = -1, total = 0;
   if (std::sscanf(line, "%lf %lf %lf %d/%d", &l1, &l5, &l15, &running, &total) != 5) return -1;
   return running;
+}
+
+char task_state(const char* stat_line) {
+  const char* close = std::strrchr(stat_line, ')');   // the name in parentheses may hold ')' itself
+  if (!close || close[1] != ' ' || close[2] == '\0') return '?';
+  return close[2];
+}
+
+int own_runnable_threads() {
+  std::error_code ec;
+  int running = 0;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task", ec)) {
+    FILE* f = std::fopen((task.path() / "stat").c_str(), "r");
+    if (!f) continue;   // a thread that ended since the listing
+    char line[512] = {};
+    const bool read = std::fgets(line, sizeof line, f) != nullptr;
+    std::fclose(f);
+    if (read && task_state(line) == 'R') ++running;
+  }
+  return ec ? -1 : running;
 }
 
 void fit_threads_to_load() {
@@ -59,7 +81,10 @@ void fit_threads_to_load() {
     const bool read = std::fgets(line, sizeof line, f) != nullptr;
     std::fclose(f);
     const int n = read ? runnable_tasks(line) : -1;
-    if (n >= 0) samples.push_back(n);
+    // Our own threads are not load: OpenMP's workers spin for a while after each loop, and the
+    // sampling thread itself is running.
+    const int own = n >= 0 ? own_runnable_threads() : -1;
+    if (own >= 0) samples.push_back(std::max(n - std::max(own, 1), 0));
   }
   const int threads = cores_left(usable, samples);
   omp_set_num_threads(threads);

@@ -18,19 +18,26 @@ inline constexpr int kMaxThreads = 1024;
 /// it before any OpenCL platform is listed. InputError outside 1…kMaxThreads. The count then stays.
 void set_thread_count(int threads);
 
-/// The cores left to this process: `usable` (those it may run on) less the other tasks running now,
-/// from samples of the kernel's count of runnable tasks, each of which includes the sampling
-/// thread itself: usable − (median − 1), within [1, usable].
-int cores_left(int usable, std::vector<int> runnable_samples);
+/// The cores left to this process: `usable` (those it may run on) less the median of samples of the
+/// runnable tasks that are not this process's threads, within [1, usable].
+int cores_left(int usable, std::vector<int> others_samples);
 
 /// The runnable tasks in a /proc/loadavg line ("0.50 0.60 0.70 3/512 1234": 3), or −1 if the line
 /// has no such field.
 int runnable_tasks(const char* loadavg_line);
 
+/// The state letter of a /proc/<pid>/task/<tid>/stat line ("123 (name) R 1 …": 'R'), or '?'.
+char task_state(const char* stat_line);
+
+/// This process's threads the kernel counts as runnable now (state R, the caller included), or −1
+/// when /proc/self/task cannot be read.
+int own_runnable_threads();
+
 /// Unless the count is fixed (set_thread_count, or OMP_NUM_THREADS in the environment), OpenMP's
 /// loops use cores_left() of the cores this process may use, from five reads of /proc/loadavg 2 ms
-/// apart, until the next call. Called at the start of each stage; a stage's count does not follow a
-/// load that starts during it. PoCL's device keeps the count it was opened with.
+/// apart, each less own_runnable_threads() (OpenMP's workers spin for some milliseconds after each
+/// loop, and count as runnable), until the next call. Called at the start of each stage; a stage's
+/// count does not follow a load that starts during it. PoCL's device keeps the count it was opened with.
 void fit_threads_to_load();
 
 }  // namespace pneumo
