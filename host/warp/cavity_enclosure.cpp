@@ -17,13 +17,17 @@ int64_t enclose_cavity(WarpResult& r, const WarpMesh& mesh, const WarpSource& sr
   // At rest, 0 where rule 4 would keep the voxel as it is (no mesh there) and the roles call it
   // `other`, 1 elsewhere; filling the holes leaves 0 on what reaches the border only. Zero
   // displacement therefore changes nothing: the same voxels are kept, and they reach it the same way.
+  // Row by row: 10⁸ voxels, and no division per voxel to find its (i, j, k).
   std::vector<uint8_t> inside_at_rest(static_cast<std::size_t>(n));
+  const int64_t nx = box.dims[0], ny = box.dims[1], nz = box.dims[2];
 #pragma omp parallel for schedule(static)
-  for (int64_t v = 0; v < n; ++v) {
-    const int64_t i = box.lo[0] + v % box.dims[0], j = box.lo[1] + (v / box.dims[0]) % box.dims[1],
-                  k = box.lo[2] + v / (box.dims[0] * box.dims[1]);
-    inside_at_rest[v] = src.roles[mesh.grid.linear_index(i, j, k)] != Role::Other || mesh.in_rest_space(i, j, k);
-  }
+  for (int64_t z = 0; z < nz; ++z)
+    for (int64_t y = 0; y < ny; ++y) {
+      const int64_t i0 = box.lo[0], j = box.lo[1] + y, k = box.lo[2] + z;
+      const Role* role = src.roles + mesh.grid.linear_index(i0, j, k);
+      uint8_t* inside = inside_at_rest.data() + nx * (y + ny * z);
+      for (int64_t x = 0; x < nx; ++x) inside[x] = role[x] != Role::Other || mesh.in_rest_space(i0 + x, j, k);
+    }
   fill_holes_per_axial_slice(inside_at_rest, frame);
 
   // After: 0 where a kept voxel was outside at rest (rule 4 left it as it was), 1 elsewhere.

@@ -9,14 +9,6 @@
 
 namespace pneumo {
 
-bool WarpMesh::in_rest_space(int64_t i, int64_t j, int64_t k) const {
-  if (i < 0 || j < 0 || k < 0) return false;
-  const int64_t L = cube_voxels;
-  const int64_t a = i / L, b = j / L, c = k / L;
-  if (a >= cubes[0] || b >= cubes[1] || c >= cubes[2]) return false;
-  return cube_meshed[std::size_t(a + cubes[0] * (b + cubes[1] * c))] != 0;
-}
-
 WarpMesh make_warp_mesh(const Mesh& mesh, const std::vector<Vec3>& displacement_m) {
   if (int64_t(displacement_m.size()) != mesh.node_count())
     throw std::invalid_argument("make_warp_mesh: " + std::to_string(displacement_m.size()) + " displacements for " +

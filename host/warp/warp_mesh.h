@@ -35,8 +35,15 @@ struct WarpMesh {
 
   int64_t tet_count() const { return int64_t(tets.size()); }
   Vec3 deformed_ijk(int32_t node) const { return rest_ijk[node] + disp_ijk[node]; }
-  /// Whether working-grid voxel (i,j,k) lies in a cube the meshes filled at rest.
-  bool in_rest_space(int64_t i, int64_t j, int64_t k) const;
+  /// Whether working-grid voxel (i,j,k) lies in a cube the meshes filled at rest. Inline: rule 5
+  /// (cavity_enclosure.h) asks it for most of 10⁸ voxels.
+  bool in_rest_space(int64_t i, int64_t j, int64_t k) const {
+    if (i < 0 || j < 0 || k < 0) return false;
+    const int64_t L = cube_voxels;
+    const int64_t a = i / L, b = j / L, c = k / L;
+    if (a >= cubes[0] || b >= cubes[1] || c >= cubes[2]) return false;
+    return cube_meshed[std::size_t(a + cubes[0] * (b + cubes[1] * c))] != 0;
+  }
 };
 
 /// Throws std::invalid_argument naming the first thing `m` gets wrong of what both warps index by without checks:
