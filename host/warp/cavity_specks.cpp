@@ -1,8 +1,26 @@
 #include "warp/cavity_specks.h"
 
+#include <cstdint>
 #include <vector>
 
 namespace pneumo {
+
+namespace {
+
+/// One bit per voxel. The gas is a few per cent of a grid of up to 10⁸ voxels: a byte or a piece id
+/// per voxel would cost 8 or 32 times the memory, and the fresh pages' faults cost more than the search.
+class VoxelBits {
+ public:
+  explicit VoxelBits(int64_t n) : words_(std::size_t((n + 63) / 64), 0) {}
+  bool test(int64_t v) const { return (words_[std::size_t(v >> 6)] >> (v & 63)) & 1u; }
+  void set(int64_t v) { words_[std::size_t(v >> 6)] |= uint64_t(1) << (v & 63); }
+  void clear(int64_t v) { words_[std::size_t(v >> 6)] &= ~(uint64_t(1) << (v & 63)); }
+
+ private:
+  std::vector<uint64_t> words_;
+};
+
+}  // namespace
 
 SpeckFill fill_cavity_specks(WarpResult& r, const Index3& dims, int64_t min_voxels) {
   SpeckFill out;
@@ -20,17 +38,16 @@ SpeckFill fill_cavity_specks(WarpResult& r, const Index3& dims, int64_t min_voxe
     }
   };
   // Pieces by breadth-first search; the small ones' voxels are collected.
-  std::vector<int32_t> piece(std::size_t(n), -1);
+  VoxelBits seen(n);
   std::vector<int64_t> small, queue;
-  int32_t pieces = 0;
   for (int64_t s = 0; s < n; ++s) {
-    if (!is_gas(s) || piece[s] >= 0) continue;
+    if (!is_gas(s) || seen.test(s)) continue;
     queue.assign(1, s);
-    piece[s] = pieces;
+    seen.set(s);
     for (std::size_t q = 0; q < queue.size(); ++q)
       neighbours(queue[q], [&](int64_t u) {
-        if (is_gas(u) && piece[u] < 0) {
-          piece[u] = pieces;
+        if (is_gas(u) && !seen.test(u)) {
+          seen.set(u);
           queue.push_back(u);
         }
       });
@@ -38,22 +55,21 @@ SpeckFill fill_cavity_specks(WarpResult& r, const Index3& dims, int64_t min_voxe
       small.insert(small.end(), queue.begin(), queue.end());
       ++out.pieces;
     }
-    ++pieces;
   }
   // Fill inward: each pass gives every small-piece voxel with a filled or non-gas neighbour that
   // neighbour's values (the first in the fixed order −i, +i, −j, +j, −k, +k), read before the pass.
-  std::vector<uint8_t> pending(std::size_t(n), 0);
-  for (int64_t v : small) pending[v] = 1;
+  VoxelBits pending(n);
+  for (int64_t v : small) pending.set(v);
   std::vector<std::pair<int64_t, int64_t>> updates;   // (voxel, source)
   bool progress = true;
   while (progress) {
     progress = false;
     updates.clear();
     for (int64_t v : small) {
-      if (!pending[v]) continue;
+      if (!pending.test(v)) continue;
       int64_t src = -1;
       neighbours(v, [&](int64_t u) {
-        if (src < 0 && !pending[u] && !is_gas(u)) src = u;
+        if (src < 0 && !pending.test(u) && !is_gas(u)) src = u;
       });
       if (src >= 0) updates.emplace_back(v, src);
     }
@@ -61,7 +77,7 @@ SpeckFill fill_cavity_specks(WarpResult& r, const Index3& dims, int64_t min_voxe
       r.ct_hu[v] = r.ct_hu[src];
       if (labels) r.labels[v] = r.labels[src];
       r.outcome[v] = WarpOutcome::Carried;
-      pending[v] = 0;
+      pending.clear(v);
       ++out.voxels;
       progress = true;
     }
