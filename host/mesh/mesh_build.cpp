@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <sstream>
 
 #include "core/error.h"
@@ -57,46 +56,65 @@ struct CubeContent {
 std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& lat, int L,
                                         const VoxelYoungFn& young_pa_for) {
   const Geometry& g = roles.geometry;
-  const int s = samples_per_voxel(L);
+  const int s = samples_per_voxel(L), s3 = s * s * s;
+  // Which tetrahedron holds each sample point of each voxel of a cube, for both patterns: the same in
+  // every cube, so found once here, not for each of 10⁸ voxels. Voxel (x,y,z) of the cube, sample m.
+  std::vector<uint8_t> tet_of[2];
+  for (int odd = 0; odd < 2; ++odd) {
+    tet_of[odd].resize(std::size_t(L) * L * L * s3);
+    for (int z = 0; z < L; ++z)
+      for (int y = 0; y < L; ++y)
+        for (int x = 0; x < L; ++x)
+          for (int mz = 0; mz < s; ++mz)
+            for (int my = 0; my < s; ++my)
+              for (int mx = 0; mx < s; ++mx) {
+                const std::array<double, 3> u{(double(x) + (mx + 0.5) / s) / L, (double(y) + (my + 0.5) / s) / L,
+                                              (double(z) + (mz + 0.5) / s) / L};
+                tet_of[odd][std::size_t(((z * L + y) * L + x) * s3 + (mz * s + my) * s + mx)] =
+                    uint8_t(lattice::tet_holding(u, odd != 0));
+              }
+  }
   std::vector<CubeContent> out(lat.cubes[0] * lat.cubes[1] * lat.cubes[2]);
-#pragma omp parallel for schedule(dynamic) collapse(2)
-  for (int64_t c = 0; c < lat.cubes[2]; ++c)
-    for (int64_t b = 0; b < lat.cubes[1]; ++b)
-      for (int64_t a = 0; a < lat.cubes[0]; ++a) {
-        CubeContent cc;
-        const bool odd = ((a + b + c) & 1) != 0;
-        std::map<uint16_t, int> counts[kParts];
-        for (int64_t k = c * L; k < std::min<int64_t>((c + 1) * L, g.dims[2]); ++k)
-          for (int64_t j = b * L; j < std::min<int64_t>((b + 1) * L, g.dims[1]); ++j)
-            for (int64_t i = a * L; i < std::min<int64_t>((a + 1) * L, g.dims[0]); ++i) {
-              const int64_t v = g.linear_index(i, j, k);
-              const Role r = roles.role[v];
-              cc.has[static_cast<int>(r)] = true;
-              if (r != Role::Wall && r != Role::Viscera) continue;
-              const int p = r == Role::Wall ? 0 : 1;
-              const uint16_t id = roles.label ? roles.label[v] : 0;
-              ++counts[p][id];
-              const double young = young_pa_for(r, id, roles.hu ? roles.hu[v] : 0.0f);
-              // The voxel's sample points, in the cube's local coordinates u ∈ [0,1]³.
-              for (int mz = 0; mz < s; ++mz)
-                for (int my = 0; my < s; ++my)
-                  for (int mx = 0; mx < s; ++mx) {
-                    const std::array<double, 3> u{(double(i - a * L) + (mx + 0.5) / s) / L,
-                                                  (double(j - b * L) + (my + 0.5) / s) / L,
-                                                  (double(k - c * L) + (mz + 0.5) / s) / L};
-                    const int kt = lattice::tet_holding(u, odd);
-                    ++cc.tissue[p][kt];
-                    cc.young_sum[p][kt] += young;
-                    cc.compliance_sum[p][kt] += 1.0 / young;
-                  }
-            }
-        for (int p = 0; p < kParts; ++p) {
-          int best = -1;
-          for (auto [id, n] : counts[p])
-            if (n > best) { best = n; cc.label[p] = id; }
+#pragma omp parallel
+  {
+    // Voxels per label, per part, in the cube at hand: a cube holds a few labels.
+    std::vector<std::pair<uint16_t, int>> counts[kParts];
+#pragma omp for schedule(dynamic) collapse(2)
+    for (int64_t c = 0; c < lat.cubes[2]; ++c)
+      for (int64_t b = 0; b < lat.cubes[1]; ++b)
+        for (int64_t a = 0; a < lat.cubes[0]; ++a) {
+          CubeContent cc;
+          const int odd = ((a + b + c) & 1) != 0;
+          for (auto& n : counts) n.clear();
+          for (int64_t k = c * L; k < std::min<int64_t>((c + 1) * L, g.dims[2]); ++k)
+            for (int64_t j = b * L; j < std::min<int64_t>((b + 1) * L, g.dims[1]); ++j)
+              for (int64_t i = a * L; i < std::min<int64_t>((a + 1) * L, g.dims[0]); ++i) {
+                const int64_t v = g.linear_index(i, j, k);
+                const Role r = roles.role[v];
+                cc.has[static_cast<int>(r)] = true;
+                if (r != Role::Wall && r != Role::Viscera) continue;
+                const int p = r == Role::Wall ? 0 : 1;
+                const uint16_t id = roles.label ? roles.label[v] : 0;
+                auto hit = std::find_if(counts[p].begin(), counts[p].end(), [&](const auto& e) { return e.first == id; });
+                if (hit == counts[p].end()) counts[p].emplace_back(id, 1);
+                else ++hit->second;
+                const double young = young_pa_for(r, id, roles.hu ? roles.hu[v] : 0.0f), compliance = 1.0 / young;
+                const uint8_t* tet = tet_of[odd].data() + ((((k - c * L) * L + (j - b * L)) * L + (i - a * L)) * s3);
+                for (int m = 0; m < s3; ++m) {
+                  ++cc.tissue[p][tet[m]];
+                  cc.young_sum[p][tet[m]] += young;
+                  cc.compliance_sum[p][tet[m]] += compliance;
+                }
+              }
+          // The most frequent label; on a tie the lowest id.
+          for (int p = 0; p < kParts; ++p) {
+            int best = -1;
+            for (auto [id, n] : counts[p])
+              if (n > best || (n == best && id < cc.label[p])) { best = n; cc.label[p] = id; }
+          }
+          out[lat.cube_index(a, b, c)] = cc;
         }
-        out[lat.cube_index(a, b, c)] = cc;
-      }
+  }
   return out;
 }
 
