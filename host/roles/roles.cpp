@@ -52,7 +52,14 @@ std::vector<uint16_t> padded_labels(const Volume* labels, const Geometry& ct_gri
 
 }  // namespace
 
-int64_t RoleVolume::count(Role r) const { return int64_t(std::count(role.begin(), role.end(), r)); }
+int64_t RoleVolume::count(Role r) const {
+  // 10⁸ voxels on a 0.75 mm CT, counted for the metrics and the roles' picture: on every core.
+  const int64_t n = int64_t(role.size());
+  int64_t c = 0;
+#pragma omp parallel for schedule(static) reduction(+ : c)
+  for (int64_t v = 0; v < n; ++v) c += role[std::size_t(v)] == r;
+  return c;
+}
 
 double RoleVolume::voxel_volume_ml() const {
   return geometry.spacing_mm[0] * geometry.spacing_mm[1] * geometry.spacing_mm[2] / 1000.0;
