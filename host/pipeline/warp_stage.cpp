@@ -123,10 +123,13 @@ DeformedMesh load_deformed_mesh(const Scene& scene, const std::string& sim_dir) 
 void check_cavity_label_free(const Scene& scene, const RoleVolume& roles) {
   if (scene.inputs.labels.empty()) return;
   const uint16_t cavity = uint16_t(scene.output.cavity_label);
-  for (uint16_t l : roles.label)
-    if (l == cavity)
-      throw file_error(scene.inputs.labels, "already uses label " + std::to_string(cavity) +
-                                                ", the cavity's id; choose a free one with output.cavity_label");
+  const int64_t n = int64_t(roles.label.size());
+  int used = 0;   // 10⁸ voxels on a 0.75 mm CT: on every core, without a branch per voxel
+#pragma omp parallel for schedule(static) reduction(| : used)
+  for (int64_t v = 0; v < n; ++v) used |= roles.label[std::size_t(v)] == cavity;
+  if (used)
+    throw file_error(scene.inputs.labels, "already uses label " + std::to_string(cavity) +
+                                              ", the cavity's id; choose a free one with output.cavity_label");
 }
 
 WarpedCase warp_scene(const Scene& scene, const std::string& sim_dir) {
