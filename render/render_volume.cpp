@@ -15,21 +15,23 @@ RenderVolume RenderVolume::from(const Volume& ct, const Volume* labels) {
   return from_hu(ct.geometry(), ct.to_float32(), labels);
 }
 
-RenderVolume RenderVolume::from_hu(const Geometry& g, std::vector<float> hu, const Volume* labels) {
+RenderVolume RenderVolume::from_hu(const Geometry& g, std::vector<float>&& hu, const Volume* labels) {
+  const int64_t n = int64_t(hu.size());
+  bool all_int16 = true;
+#pragma omp parallel for schedule(static) reduction(&& : all_int16)
+  for (int64_t i = 0; i < n; ++i) all_int16 = all_int16 && fits_int16_texture(hu[std::size_t(i)]);
+  return from_hu(g, std::move(hu), labels, all_int16);
+}
+
+RenderVolume RenderVolume::from_hu(const Geometry& g, std::vector<float>&& hu, const Volume* labels,
+                                   bool hu_is_int16) {
   if (int64_t(hu.size()) != g.voxel_count())
     throw std::invalid_argument("RenderVolume::from_hu: " + std::to_string(hu.size()) + " values for " +
                                 std::to_string(g.voxel_count()) + " voxels");
   RenderVolume v;
   v.geometry = g;
-  v.hu = std::move(hu);
+  v.hu_is_int16 = hu_is_int16;
   const int64_t n = g.voxel_count();
-  bool all_int16 = true;
-#pragma omp parallel for schedule(static) reduction(&& : all_int16)
-  for (int64_t i = 0; i < n; ++i) {
-    const float x = v.hu[std::size_t(i)];
-    all_int16 = all_int16 && x >= -32767.0f && x <= 32767.0f && x == std::nearbyint(x);
-  }
-  v.hu_is_int16 = all_int16;
   if (labels) {
     if (!labels->geometry().same_grid(g, 1e-3))
       throw InputError("the label map's voxel grid differs from the CT's; the renderer needs them on one grid");
@@ -48,6 +50,7 @@ RenderVolume RenderVolume::from_hu(const Geometry& g, std::vector<float> hu, con
     if (first_bad < n)
       throw InputError("label map value " + std::to_string(labels->value(first_bad)) + " is not an id from 0 to 65534");
   }
+  v.hu = std::move(hu);   // last: a refused label map leaves the caller's values with it
   return v;
 }
 

@@ -17,6 +17,10 @@ namespace pneumo {
 /// mark_exterior_air(); never a real organ id (TotalSegmentator ids stay below 256).
 inline constexpr uint16_t kExteriorAirLabel = 65535;
 
+/// Whether a 16-bit texture holds HU value x as it is: an integer in [−32767, 32767] (snorm16 has no
+/// value for −32768). RenderVolume::hu_is_int16 holds when every voxel does.
+inline bool fits_int16_texture(float x) { return x >= -32767.0f && x <= 32767.0f && x == std::nearbyint(x); }
+
 struct RenderVolume {
   Geometry geometry;
   std::vector<float> hu;          // voxel_count() values, i fastest
@@ -34,9 +38,13 @@ struct RenderVolume {
   /// From a CT (any voxel type) and an optional label map; InputError when the label map's grid
   /// differs from the CT's or its ids do not fit 16 bits.
   static RenderVolume from(const Volume& ct, const Volume* labels);
-  /// The same from HU already in floats on grid `g` (taken, not copied: a run hands the warp's own),
-  /// and an optional label map on that grid.
-  static RenderVolume from_hu(const Geometry& g, std::vector<float> hu, const Volume* labels);
+  /// The same from HU already in floats on grid `g` (taken, not copied: a run hands the warp's own,
+  /// and gets it back from the volume after the views), and an optional label map on that grid.
+  /// `hu` is taken only on return: when the label map is refused, the caller still holds it.
+  static RenderVolume from_hu(const Geometry& g, std::vector<float>&& hu, const Volume* labels);
+  /// The same when the caller knows whether every value fits_int16_texture (round_as_written says,
+  /// in the pass that rounds them): the 10⁸ values are not read again.
+  static RenderVolume from_hu(const Geometry& g, std::vector<float>&& hu, const Volume* labels, bool hu_is_int16);
 
   /// Labels air (HU ≤ threshold) connected to the grid's faces as kExteriorAirLabel (6-connected
   /// flood fill), creating an all-zero label map first when there is none. Exterior views hide it.

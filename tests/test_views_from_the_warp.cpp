@@ -6,6 +6,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "core/error.h"
 #include "pipeline/warp_stage.h"
 #include "render/render_volume.h"
 
@@ -29,13 +30,18 @@ TEST(ViewsFromTheWarp, TheWarpsHuRoundedAsWrittenAreTheWrittenCtsHu) {
     w.result.ct_hu = warped;
     const Volume written = deformed_ct_volume(w);
     const RenderVolume from_file = RenderVolume::from(written, nullptr);
+    EXPECT_EQ(deformed_ct_type(w), written.type());
     std::vector<float> taken = warped;
-    round_as_written(taken, written.type());
-    const RenderVolume from_warp = RenderVolume::from_hu(g, std::move(taken), nullptr);
+    const bool int16 = round_as_written(taken, written.type());
+    // Rounding twice changes nothing: the run rounds the HU for the views and writes them after.
+    std::vector<float> again = taken;
+    round_as_written(again, written.type());
+    ASSERT_EQ(again, taken) << int(input);
+    const RenderVolume from_warp = RenderVolume::from_hu(g, std::move(taken), nullptr, int16);
     ASSERT_EQ(from_warp.hu.size(), from_file.hu.size());
     for (std::size_t n = 0; n < warped.size(); ++n)
       ASSERT_EQ(from_warp.hu[n], from_file.hu[n]) << "voxel " << n << ", input type " << int(input);
-    EXPECT_EQ(from_warp.hu_is_int16, from_file.hu_is_int16) << int(input);
+    EXPECT_EQ(from_warp.hu_is_int16, from_file.hu_is_int16) << int(input);   // found in the rounding pass
     EXPECT_EQ(from_warp.geometry.dims, g.dims);
   }
   // Rounded to the nearest (ties to even) and clamped to 16 bits, as the file holds them.
@@ -45,9 +51,30 @@ TEST(ViewsFromTheWarp, TheWarpsHuRoundedAsWrittenAreTheWrittenCtsHu) {
   EXPECT_EQ(int16[1], -10.0f);
   EXPECT_EQ(int16[2], 32767.0f);
   EXPECT_EQ(int16[3], -32768.0f);
-  EXPECT_FALSE(RenderVolume::from_hu(g, int16, nullptr).hu_is_int16);   // −32768 has no snorm16 value
+  EXPECT_FALSE(RenderVolume::from_hu(g, std::vector<float>(int16), nullptr).hu_is_int16);   // −32768: no snorm16
   int16[3] = -1000.0f;
-  EXPECT_TRUE(RenderVolume::from_hu(g, int16, nullptr).hu_is_int16);
+  EXPECT_TRUE(RenderVolume::from_hu(g, std::vector<float>(int16), nullptr).hu_is_int16);
+  EXPECT_TRUE(round_as_written(int16, VoxelType::Int16));
+}
+
+TEST(ViewsFromTheWarp, ARefusedLabelMapLeavesTheHuWithTheCaller) {
+  // The run writes the deformed CT from the HU it handed over when the views fail: a label map the
+  // renderer refuses must not take them with it.
+  Geometry g;
+  g.dims = {4, 3, 2};
+  std::vector<float> hu(std::size_t(g.voxel_count()), 40.0f);
+  Geometry other = g;
+  other.dims = {4, 3, 3};
+  const Volume off_grid(other, VoxelType::UInt8);
+  EXPECT_THROW(RenderVolume::from_hu(g, std::move(hu), &off_grid, true), InputError);
+  EXPECT_EQ(hu.size(), std::size_t(g.voxel_count()));
+  Volume bad_id(g, VoxelType::Float32);
+  bad_id.data<float>()[5] = 2.5f;
+  EXPECT_THROW(RenderVolume::from_hu(g, std::move(hu), &bad_id, true), InputError);
+  ASSERT_EQ(hu.size(), std::size_t(g.voxel_count()));
+  EXPECT_EQ(hu[0], 40.0f);
+  const RenderVolume v = RenderVolume::from_hu(g, std::move(hu), nullptr, true);
+  EXPECT_EQ(v.hu.size(), std::size_t(g.voxel_count()));
 }
 
 TEST(ViewsFromTheWarp, ValuesForAnotherGridAreRefused) {

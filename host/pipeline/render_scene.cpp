@@ -144,10 +144,11 @@ RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
 RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Volume& ct, const Volume* labels,
                          RenderRun run) {
   fit_threads_to_load();
-  return render_volumes(scene, opt, RenderVolume::from(ct, labels), std::move(run));
+  RenderVolume volume = RenderVolume::from(ct, labels);
+  return render_volumes(scene, opt, volume, std::move(run));
 }
 
-RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, RenderVolume volume, RenderRun run) {
+RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, RenderVolume& volume, RenderRun run) {
   fit_threads_to_load();
   const auto start = std::chrono::steady_clock::now();
   const ViewSettings& r = scene.render;

@@ -164,7 +164,6 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   RenderRun what;
   what.deformed = true;
   what.ct_path = (out / "deformed_ct.nii.gz").string();
-  const Volume deformed_ct = deformed_ct_volume(w);
   std::optional<Volume> deformed_labels;
   if (w.labels) {
     deformed_labels = deformed_label_volume(w, scene.output.cavity_label);
@@ -173,19 +172,27 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   const Volume* const labels_out = deformed_labels ? &*deformed_labels : nullptr;
   // The views first, from memory, and the warp's files after them: a user waits for the first view,
   // not for deflating 10⁸ voxels. A render that fails still leaves the warp's files written.
+  // The views take the warp's own HU, rounded as the file holds them (not a float copy of 10⁸
+  // voxels), and give them back for the deformed CT, built after the views.
   RenderRun rendered;
+  RenderVolume views;
+  const auto take_back = [&] {
+    if (!views.hu.empty()) w.result.ct_hu = std::move(views.hu);
+  };
   try {
-    // The views take the warp's own HU (rounded as the file holds them), not a float copy of 10⁸ voxels.
-    std::vector<float> hu = std::move(w.result.ct_hu);
-    round_as_written(hu, deformed_ct.type());
-    rendered = render_volumes(scene, ro, RenderVolume::from_hu(deformed_ct.geometry(), std::move(hu), labels_out), what);
+    const bool int16 = round_as_written(w.result.ct_hu, deformed_ct_type(w));
+    views = RenderVolume::from_hu(w.output_grid, std::move(w.result.ct_hu), labels_out, int16);
+    rendered = render_volumes(scene, ro, views, what);
   } catch (...) {
-    write_warp(scene, w, o.out_dir, &deformed_ct, labels_out);
+    take_back();
+    write_warp(scene, w, o.out_dir, labels_out);
     throw;
   }
+  take_back();
+  views = RenderVolume();   // its labels' copy, before the deformed CT is built
   const double seconds_render = seconds_since(t_render);
   log::info("writing the warped CT and labels");
-  write_warp(scene, w, o.out_dir, &deformed_ct, labels_out);
+  write_warp(scene, w, o.out_dir, labels_out);
 
   // Report: landmarks, plots, metrics (complete), report.html last.
   log::info("stage 4/4: report");

@@ -223,10 +223,15 @@ WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labe
   return w;
 }
 
-Volume deformed_ct_volume(const WarpedCase& w) {
-  VoxelType t = w.ct.type();
+VoxelType deformed_ct_type(const WarpedCase& w) {
+  const VoxelType t = w.ct.type();
   if (t != VoxelType::Int16 && t != VoxelType::Int32 && t != VoxelType::Float32 && t != VoxelType::Float64)
-    t = VoxelType::Float32;
+    return VoxelType::Float32;
+  return t;
+}
+
+Volume deformed_ct_volume(const WarpedCase& w) {
+  const VoxelType t = deformed_ct_type(w);
   Volume v(w.output_grid, t);
   dispatch_voxel_type(t, v.raw(), [&](auto* p) {
     using T = std::remove_pointer_t<decltype(p)>;
@@ -235,15 +240,19 @@ Volume deformed_ct_volume(const WarpedCase& w) {
   return v;
 }
 
-void round_as_written(std::vector<float>& hu, VoxelType written) {
+bool round_as_written(std::vector<float>& hu, VoxelType written) {
+  const int64_t count = int64_t(hu.size());
+  bool all_int16 = true;
   dispatch_voxel_type(written, nullptr, [&](auto* p) {
     using T = std::remove_pointer_t<decltype(p)>;
-    if constexpr (std::is_integral_v<T>) {   // floating types hold the values as they are
-      const int64_t count = int64_t(hu.size());
-#pragma omp parallel for schedule(static)
-      for (int64_t n = 0; n < count; ++n) hu[std::size_t(n)] = float(as_written<T>(hu[std::size_t(n)]));
+#pragma omp parallel for schedule(static) reduction(&& : all_int16)
+    for (int64_t n = 0; n < count; ++n) {
+      float& x = hu[std::size_t(n)];
+      if constexpr (std::is_integral_v<T>) x = float(as_written<T>(x));   // floating types hold them as they are
+      all_int16 = all_int16 && fits_int16_texture(x);
     }
   });
+  return all_int16;
 }
 
 std::map<int, std::string> scene_label_names(const Scene& scene) {
@@ -384,16 +393,14 @@ class WarpOutputs {
 };
 }  // namespace
 
-void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir, const Volume* deformed_ct,
-                const Volume* deformed_labels) {
+void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir, const Volume* deformed_labels) {
   nlohmann::json metrics = read_metrics(dir);
   check_writable_target(in_dir(dir, "metrics.json"));
   // An earlier warp replaced (--force) stops counting as finished before its images are replaced.
   if (metrics.erase("warp") > 0) write_text_file_atomic(in_dir(dir, "metrics.json"), metrics.dump(2) + "\n");
   WarpOutputs outputs(dir);
-  std::optional<Volume> built_ct;   // 10⁸ voxels on a clinical CT: built once, when not given
+  std::optional<Volume> built_ct;   // 10⁸ voxels on a clinical CT: built once, when first needed
   auto after_ct = [&]() -> const Volume& {
-    if (deformed_ct) return *deformed_ct;
     if (!built_ct) built_ct = deformed_ct_volume(w);
     return *built_ct;
   };

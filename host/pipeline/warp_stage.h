@@ -76,12 +76,16 @@ WarpedCase warp_scene(const Scene& scene, const std::string& sim_dir);
 WarpedCase warp_solved(const Scene& scene, Volume ct, std::optional<Volume> labels, RoleVolume roles, Mesh mesh,
                        Deformation deformation);
 
-/// The deformed CT in the input's voxel type where it can hold HU (int16, int32 rounded to the
+/// The deformed CT's voxel type: the input's where it can hold HU (int16, int32 rounded to the
 /// nearest HU; float32, float64 as computed), float32 otherwise (unsigned or 8-bit types).
+VoxelType deformed_ct_type(const WarpedCase& w);
+/// The deformed CT in deformed_ct_type(w).
 Volume deformed_ct_volume(const WarpedCase& w);
 /// The warp's HU as deformed_ct_volume writes them, in floats: rounded in place to the nearest HU
-/// and clamped where `written` (deformed_ct_volume's type) is an integer type, as they are.
-void round_as_written(std::vector<float>& hu, VoxelType written);
+/// and clamped where `written` (deformed_ct_type) is an integer type, as they are. Rounding again
+/// changes nothing. Returns whether every value then fits_int16_texture (render_volume.h), found in
+/// the same pass, for RenderVolume::from_hu.
+bool round_as_written(std::vector<float>& hu, VoxelType written);
 /// The scene's inputs.label_names (io/label_table.h), empty when unset: read before any long work so
 /// that a bad file is refused at once.
 std::map<int, std::string> scene_label_names(const Scene& scene);
@@ -102,9 +106,9 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w);
 /// as the scene's output.write_* ask, then adds warp_metrics() to DIR/metrics.json: cavity_voxels
 /// and cavity_volume_ml become the warped cavity's, the mesh's own estimate stays as
 /// mesh_cavity_volume_ml. Every file is written atomically, metrics.json last.
-/// `deformed_ct` and `deformed_labels`, when given, are deformed_ct_volume(w) and
-/// deformed_label_volume(w, …) already built (the run renders them first): not built again.
-void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir, const Volume* deformed_ct = nullptr,
+/// The deformed CT is built once, here. `deformed_labels`, when given, is deformed_label_volume(w, …)
+/// already built (the run renders it first): not built again.
+void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir,
                 const Volume* deformed_labels = nullptr);
 
 }  // namespace pneumo
