@@ -56,10 +56,12 @@ char task_state(const char* stat_line) {
 }
 
 int own_runnable_threads() {
+  namespace fs = std::filesystem;
   std::error_code ec;
   int running = 0;
-  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task", ec)) {
-    FILE* f = std::fopen((task.path() / "stat").c_str(), "r");
+  // Incremented with an error code: a range-for's ++ would throw from the start of a stage.
+  for (fs::directory_iterator it("/proc/self/task", ec), end; !ec && it != end; it.increment(ec)) {
+    FILE* f = std::fopen((it->path() / "stat").c_str(), "r");
     if (!f) continue;   // a thread that ended since the listing
     char line[512] = {};
     const bool read = std::fgets(line, sizeof line, f) != nullptr;
@@ -81,10 +83,13 @@ void fit_threads_to_load() {
     const bool read = std::fgets(line, sizeof line, f) != nullptr;
     std::fclose(f);
     const int n = read ? runnable_tasks(line) : -1;
+    if (n < 0) continue;
     // Our own threads are not load: OpenMP's workers spin for a while after each loop, and the
-    // sampling thread itself is running.
-    const int own = n >= 0 ? own_runnable_threads() : -1;
-    if (own >= 0) samples.push_back(std::max(n - std::max(own, 1), 0));
+    // sampling thread itself is running (all we can take off when /proc/self/task is unreadable).
+    // The two reads are moments apart: a worker that falls asleep between them makes `others`
+    // too small by one at most, and a negative count is 0.
+    const int own = std::max(own_runnable_threads(), 1);
+    samples.push_back(std::max(n - own, 0));
   }
   const int threads = cores_left(usable, samples);
   omp_set_num_threads(threads);
