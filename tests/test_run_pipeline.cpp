@@ -3,6 +3,7 @@
 // without --force; a run resumed from a checkpoint reaches the same shape.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -132,6 +133,12 @@ TEST(RunPipeline, ARenderThatFailsStillLeavesTheWarpsFiles) {
   const fs::path out(o.out_dir);
   for (const char* f : {"deformation.bin", "deformed_ct.nii.gz", "deformed_labels.nii.gz", "slices_before_after.png"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
+  // The views had the warp's HU when they failed: the CT written after must still hold them (air
+  // around the body, tissue above 0 HU), not an empty or zeroed copy.
+  const std::vector<float> hu = read_volume((out / "deformed_ct.nii.gz").string()).to_float32();
+  ASSERT_FALSE(hu.empty());
+  EXPECT_LE(*std::min_element(hu.begin(), hu.end()), -900.0f);
+  EXPECT_GT(*std::max_element(hu.begin(), hu.end()), 0.0f);
   const nlohmann::json m = read_json(out / "metrics.json");
   EXPECT_TRUE(m.contains("warp"));
   EXPECT_GT(m.at("cavity_volume_ml").get<double>(), 0.0);

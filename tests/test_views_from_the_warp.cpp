@@ -3,6 +3,7 @@
 // one it would read from that file, value for value, for every voxel type the CT is written in.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <random>
 #include <stdexcept>
 
@@ -37,6 +38,12 @@ TEST(ViewsFromTheWarp, TheWarpsHuRoundedAsWrittenAreTheWrittenCtsHu) {
     std::vector<float> again = taken;
     round_as_written(again, written.type());
     ASSERT_EQ(again, taken) << int(input);
+    // ...and the deformed CT built from the rounded HU after the views is the file's, byte for byte.
+    WarpedCase back = w;
+    back.result.ct_hu = taken;
+    const Volume rewritten = deformed_ct_volume(back);
+    ASSERT_EQ(rewritten.type(), written.type());
+    ASSERT_EQ(std::memcmp(rewritten.raw(), written.raw(), written.byte_count()), 0) << int(input);
     const RenderVolume from_warp = RenderVolume::from_hu(g, std::move(taken), nullptr, int16);
     ASSERT_EQ(from_warp.hu.size(), from_file.hu.size());
     for (std::size_t n = 0; n < warped.size(); ++n)
@@ -75,6 +82,14 @@ TEST(ViewsFromTheWarp, ARefusedLabelMapLeavesTheHuWithTheCaller) {
   EXPECT_EQ(hu[0], 40.0f);
   const RenderVolume v = RenderVolume::from_hu(g, std::move(hu), nullptr, true);
   EXPECT_EQ(v.hu.size(), std::size_t(g.voxel_count()));
+}
+
+TEST(ViewsFromTheWarp, ADeformedCtWithoutItsHuIsRefused) {
+  // The run lends the warp's HU to the views; a CT built while they are away must not be zeros.
+  WarpedCase w;
+  w.output_grid.dims = {4, 4, 4};
+  w.ct = Volume(w.output_grid, VoxelType::Int16);
+  EXPECT_THROW(deformed_ct_volume(w), std::logic_error);
 }
 
 TEST(ViewsFromTheWarp, ValuesForAnotherGridAreRefused) {

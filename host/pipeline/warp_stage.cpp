@@ -231,6 +231,11 @@ VoxelType deformed_ct_type(const WarpedCase& w) {
 }
 
 Volume deformed_ct_volume(const WarpedCase& w) {
+  // The run lends these HU to the views and takes them back: an empty or foreign vector here would
+  // write a CT of zeros without a word.
+  if (int64_t(w.result.ct_hu.size()) != w.output_grid.voxel_count())
+    throw std::logic_error("deformed_ct_volume: " + std::to_string(w.result.ct_hu.size()) + " HU for " +
+                           std::to_string(w.output_grid.voxel_count()) + " voxels of the output grid");
   const VoxelType t = deformed_ct_type(w);
   Volume v(w.output_grid, t);
   dispatch_voxel_type(t, v.raw(), [&](auto* p) {
