@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -145,10 +146,11 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Vol
                          RenderRun run) {
   fit_threads_to_load();
   RenderVolume volume = RenderVolume::from(ct, labels);
+  volume.smoothing_mm = scene.render.smoothing_mm;
   return render_volumes(scene, opt, volume, std::move(run));
 }
 
-RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, RenderVolume& volume, RenderRun run) {
+RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const RenderVolume& volume, RenderRun run) {
   fit_threads_to_load();
   const auto start = std::chrono::steady_clock::now();
   const ViewSettings& r = scene.render;
@@ -156,7 +158,8 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, RenderVol
   const fs::path deformed_labels = out / "deformed_labels.nii.gz";
   const PointMapFn map = opt.map_point ? opt.map_point : identity_point_map();
   const bool labels = !volume.labels.empty();
-  volume.smoothing_mm = r.smoothing_mm;
+  if (volume.smoothing_mm != r.smoothing_mm)
+    throw std::logic_error("render_volumes: the volume's smoothing_mm differs from the scene's render.smoothing_mm");
   const RenderSettings s = settings_from_scene(r, volume.geometry);
 
   // Poses first: every bad one is reported before any rendering.

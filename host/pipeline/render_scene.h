@@ -55,9 +55,10 @@ RenderRun render_scene(const Scene& scene, const RenderOptions& options);
 /// carries what the report names (the volumes' paths, whether they are deformed).
 RenderRun render_volumes(const Scene& scene, const RenderOptions& options, const Volume& ct, const Volume* labels,
                          RenderRun run);
-/// The same from the renderer's volume, built by the caller (RenderVolume::from or from_hu) and left
-/// with it (a run takes the warp's HU back from it to write them), its smoothing_mm set from the scene.
-RenderRun render_volumes(const Scene& scene, const RenderOptions& options, RenderVolume& volume, RenderRun run);
+/// The same from the renderer's volume, built by the caller (RenderVolume::from or from_hu) with
+/// smoothing_mm = scene.render.smoothing_mm (std::logic_error otherwise), and left with it
+/// unchanged: a run takes the warp's HU back from it and writes them as the deformed CT.
+RenderRun render_volumes(const Scene& scene, const RenderOptions& options, const RenderVolume& volume, RenderRun run);
 
 /// The ray caster's settings from a scene's render section, for a volume on grid `g` (the step is
 /// render.step_fraction of its smallest spacing).

@@ -182,6 +182,7 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   try {
     const bool int16 = round_as_written(w.result.ct_hu, deformed_ct_type(w));
     views = RenderVolume::from_hu(w.output_grid, std::move(w.result.ct_hu), labels_out, int16);
+    views.smoothing_mm = scene.render.smoothing_mm;
     rendered = render_volumes(scene, ro, views, what);
   } catch (...) {
     take_back();
