@@ -17,7 +17,7 @@ int64_t enclose_cavity(WarpResult& r, const WarpMesh& mesh, const WarpSource& sr
   // At rest, 0 where rule 4 would keep the voxel as it is (no mesh there) and the roles call it
   // `other`, 1 elsewhere; filling the holes leaves 0 on what reaches the border only. Zero
   // displacement therefore changes nothing: the same voxels are kept, and they reach it the same way.
-  // Row by row: 10⁸ voxels, and no division per voxel to find its (i, j, k).
+  // Row by row: 10⁸ voxels, whose (i, j, k) the loops give instead of three divisions each.
   std::vector<uint8_t> inside_at_rest(static_cast<std::size_t>(n));
   const int64_t nx = box.dims[0], ny = box.dims[1], nz = box.dims[2];
 #pragma omp parallel for schedule(static)
