@@ -14,7 +14,10 @@
 // held axis leaves residuals of order 1.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <random>
+#include <string>
 
 #include "mesh/mesh.h"
 #include "mesh_test_support.h"
@@ -37,7 +40,9 @@ class NewtonClVsRef : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(NewtonClVsRef, DeviceLinearSolveMatchesTheHosts) {
   auto ctx = ocl::Context::shared(ocl::parse_device_spec(GetParam()));
-  const unsigned seed = std::random_device{}();
+  // A new case each run; PNEUMO_TEST_SEED replays the one a failure names.
+  const char* replay = std::getenv("PNEUMO_TEST_SEED");
+  const unsigned seed = replay ? unsigned(std::stoul(replay)) : std::random_device{}();
   SCOPED_TRACE("seed " + std::to_string(seed) + " on " + ctx->info().name);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -103,12 +108,23 @@ TEST_P(NewtonClVsRef, DeviceLinearSolveMatchesTheHosts) {
           }
         r2 += r.squaredNorm();
       }
+      // The float32 device's products round each term at ε = 2⁻²⁴ of its size, and CG's recursive
+      // residual drifts from the true one by about that per step (Greenbaum 1997, finite-precision
+      // CG): where the elastic and the pressure terms nearly cancel (|K d| ≫ |b|, a follower load
+      // near buckling), the true residual may exceed the 2η of the double host by iterations ·
+      // ε · (|K_el d| + |K_p d|). Seed 515817803, trial 5: 102 steps, |K_el d| = 67 |b|, |K_p d| =
+      // 24 |b|, true residual 5.0e-4 |b| (the host's 1.3e-4), against 2.0e-4 + 5.6e-4.
+      std::vector<Vec3> k_elastic, k_pressure(std::size_t(m.node_count()), Vec3::Zero());
+      field->stiffness_product(d_dev, k_elastic);
+      pressure.add_product(d_dev, k_pressure);
+      const double float_drift =
+          double(cd.iterations) * std::ldexp(1.0, -24) * (norm(k_elastic) + norm(k_pressure));
       double diff2 = 0.0;
       for (int64_t n = 0; n < m.node_count(); ++n) diff2 += (d_dev[n] - d_host[n]).squaredNorm();
       std::printf("%s: %d / %d CG steps (device / host), residual %.2e of |b|, |d_dev - d_host| %.2e of |d|\n",
                   ctx->info().name.c_str(), cd.iterations, ch.iterations, std::sqrt(r2) / norm(b),
                   std::sqrt(diff2) / norm(d_host));
-      EXPECT_LE(std::sqrt(r2), 2 * eta * norm(b));
+      EXPECT_LE(std::sqrt(r2), 2 * eta * norm(b) + float_drift);
       EXPECT_LE(std::sqrt(diff2), 1e-3 * norm(d_host));
     }
   }
