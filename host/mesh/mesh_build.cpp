@@ -53,27 +53,42 @@ struct CubeContent {
   double compliance_sum[kParts][5] = {{0, 0, 0, 0, 0}, {0, 0, 0, 0, 0}};
 };
 
-std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& lat, int L,
+/// Which tetrahedron holds each sample point of a cube, for both patterns: the same in every cube, so
+/// found once per mesh, not for each of 10⁸ voxels. Entry ((z·L + y)·L + x)·s³ + (mz·s + my)·s + mx:
+/// voxel (x,y,z) of the cube, its sample (mx,my,mz) at ((x + (mx + ½)/s) / L, …).
+struct SampleTets {
+  int L = 1, s = 1, s3 = 1;
+  std::vector<uint8_t> tet_of[2];   // [odd pattern]
+
+  explicit SampleTets(int cube_voxels) : L(cube_voxels), s(samples_per_voxel(cube_voxels)), s3(s * s * s) {
+    for (int odd = 0; odd < 2; ++odd) {
+      tet_of[odd].resize(std::size_t(L) * L * L * s3);
+      for (int z = 0; z < L; ++z)
+        for (int y = 0; y < L; ++y)
+          for (int x = 0; x < L; ++x)
+            for (int mz = 0; mz < s; ++mz)
+              for (int my = 0; my < s; ++my)
+                for (int mx = 0; mx < s; ++mx) {
+                  const std::array<double, 3> u{(double(x) + (mx + 0.5) / s) / L, (double(y) + (my + 0.5) / s) / L,
+                                                (double(z) + (mz + 0.5) / s) / L};
+                  tet_of[odd][std::size_t(((z * L + y) * L + x) * s3 + (mz * s + my) * s + mx)] =
+                      uint8_t(lattice::tet_holding(u, odd != 0));
+                }
+    }
+  }
+  /// The sample points of a whole cube in each tetrahedron (the same for both patterns, by symmetry).
+  std::array<int64_t, 5> per_tet() const {
+    std::array<int64_t, 5> count{};
+    for (uint8_t t : tet_of[0]) ++count[t];
+    return count;
+  }
+};
+
+std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& lat, const SampleTets& samples,
                                         const VoxelYoungFn& young_pa_for) {
   const Geometry& g = roles.geometry;
-  const int s = samples_per_voxel(L), s3 = s * s * s;
-  // Which tetrahedron holds each sample point of each voxel of a cube, for both patterns: the same in
-  // every cube, so found once here, not for each of 10⁸ voxels. Voxel (x,y,z) of the cube, sample m.
-  std::vector<uint8_t> tet_of[2];
-  for (int odd = 0; odd < 2; ++odd) {
-    tet_of[odd].resize(std::size_t(L) * L * L * s3);
-    for (int z = 0; z < L; ++z)
-      for (int y = 0; y < L; ++y)
-        for (int x = 0; x < L; ++x)
-          for (int mz = 0; mz < s; ++mz)
-            for (int my = 0; my < s; ++my)
-              for (int mx = 0; mx < s; ++mx) {
-                const std::array<double, 3> u{(double(x) + (mx + 0.5) / s) / L, (double(y) + (my + 0.5) / s) / L,
-                                              (double(z) + (mz + 0.5) / s) / L};
-                tet_of[odd][std::size_t(((z * L + y) * L + x) * s3 + (mz * s + my) * s + mx)] =
-                    uint8_t(lattice::tet_holding(u, odd != 0));
-              }
-  }
+  const int L = samples.L, s3 = samples.s3;
+  const std::vector<uint8_t>(&tet_of)[2] = samples.tet_of;
   std::vector<CubeContent> out(lat.cubes[0] * lat.cubes[1] * lat.cubes[2]);
 #pragma omp parallel
   {
@@ -130,17 +145,6 @@ std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& 
 double hill_modulus(double young_sum, double compliance_sum, int64_t n) {
   if (n <= 0) return 0.0;
   return 0.5 * (young_sum / double(n) + double(n) / compliance_sum);
-}
-
-/// Sample points of a whole cube in each of its tetrahedra (the same for both patterns, by symmetry).
-std::array<int64_t, 5> samples_per_tet(int L) {
-  const int n = samples_per_voxel(L) * L;
-  std::array<int64_t, 5> count{};
-  for (int z = 0; z < n; ++z)
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x)
-        ++count[lattice::tet_holding({(x + 0.5) / n, (y + 0.5) / n, (z + 0.5) / n}, false)];
-  return count;
 }
 
 /// Rest position of lattice node (a,b,c): the corner of voxel (aL, bL, cL) at index aL − ½.
@@ -569,8 +573,9 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
   const Lattice lat = lattice_of(g, L);
   require_mesh_memory(roles, opt);
 
-  const std::vector<CubeContent> content = classify_cubes(roles, lat, L, young_pa_for);
-  const std::array<int64_t, 5> tet_samples = samples_per_tet(L);
+  const SampleTets samples(L);
+  const std::vector<CubeContent> content = classify_cubes(roles, lat, samples, young_pa_for);
+  const std::array<int64_t, 5> tet_samples = samples.per_tet();
   const bool with_viscera = opt.model == MeshModel::WallViscera;
 
   const std::vector<uint8_t> meshed = meshed_parts(roles, lat, opt);
