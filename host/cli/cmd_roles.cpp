@@ -25,8 +25,10 @@ void print_summary(const Scene& scene, const RoleVolume& rv, double seconds) {
               (long long)rv.pad.hi[0], (long long)rv.pad.lo[1], (long long)rv.pad.hi[1], (long long)rv.pad.lo[2],
               (long long)rv.pad.hi[2]);
   std::printf("  %-8s %12s %12s\n", "role", "voxels", "ml");
+  const std::array<int64_t, 4> voxels = rv.counts();
   for (Role r : {Role::Wall, Role::Viscera, Role::Fixed, Role::Other})
-    std::printf("  %-8s %12lld %12.1f\n", role_name(r), (long long)rv.count(r), rv.volume_ml(r));
+    std::printf("  %-8s %12lld %12.1f\n", role_name(r), (long long)voxels[std::size_t(r)],
+                double(voxels[std::size_t(r)]) * rv.voxel_volume_ml());
 }
 
 }  // namespace

@@ -246,9 +246,10 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
     j["gravity_compensation"] = {{"sag_mm", sim.gravity.sag_mm}, {"error_mm", sim.gravity.error_mm},
                                  {"solves", sim.gravity.iterations}, {"steps", sim.gravity.solver_steps},
                                  {"wall_time_s", sim.gravity.wall_time_s}};
-  j["roles_ml"] = {{"wall", sim.roles.volume_ml(Role::Wall)},
-                   {"viscera", sim.roles.volume_ml(Role::Viscera)},
-                   {"fixed", sim.roles.volume_ml(Role::Fixed)}};
+  const std::array<double, 4> roles_ml = sim.roles.volumes_ml();
+  j["roles_ml"] = {{"wall", roles_ml[std::size_t(Role::Wall)]},
+                   {"viscera", roles_ml[std::size_t(Role::Viscera)]},
+                   {"fixed", roles_ml[std::size_t(Role::Fixed)]}};
   j["stage_seconds"] = {{"roles", sim.stage_seconds_roles}, {"mesh", sim.stage_seconds_mesh},
                         {"solve", sim.stage_seconds_solve}};
   if (!sim.pressure_curve.empty()) {

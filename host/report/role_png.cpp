@@ -11,9 +11,10 @@ namespace {
 
 std::vector<OverlayClass> role_classes(const RoleVolume& rv) {
   // Indexed by Role's value. Alpha 0.45: the anatomy stays readable under the colour.
+  const std::array<double, 4> ml = rv.volumes_ml();
   const auto entry = [&](Role r, Rgb colour, double alpha) {
     char buf[64];
-    std::snprintf(buf, sizeof buf, "%s %.2f L", role_name(r), rv.volume_ml(r) / 1000.0);
+    std::snprintf(buf, sizeof buf, "%s %.2f L", role_name(r), ml[std::size_t(r)] / 1000.0);
     return OverlayClass{buf, colour, alpha};
   };
   std::vector<OverlayClass> t(4);

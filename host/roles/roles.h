@@ -2,6 +2,7 @@
 // Roles (method.md §2): which voxels are abdominal wall, viscera, fixed or left out, on the working
 // grid of a case: the CT's grid padded with air as the scene asks (pad.h). Later stages (mesh,
 // warp, render) read everything about the case's voxels from the RoleVolume.
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -21,7 +22,10 @@ struct RoleVolume {
   std::vector<uint16_t> label;  // organ label per voxel (0 where none or unknown); same size
   Volume ct;                    // the CT on the same grid, float32 HU (padding -1000)
 
-  int64_t count(Role r) const;
+  /// Voxels of each role, indexed by the Role's value, in one pass over the grid (10⁸ voxels on a
+  /// 0.75 mm CT): callers that want several roles take them all at once.
+  std::array<int64_t, 4> counts() const;
+  int64_t count(Role r) const { return counts()[std::size_t(r)]; }
   /// The CT's HU per voxel, or null when it holds none on this grid.
   const float* hu() const {
     return ct.type() == VoxelType::Float32 && ct.voxel_count() == int64_t(role.size()) && !role.empty()
@@ -30,6 +34,12 @@ struct RoleVolume {
   }
   double voxel_volume_ml() const;   // spacing product / 1000
   double volume_ml(Role r) const { return double(count(r)) * voxel_volume_ml(); }
+  /// counts() in ml.
+  std::array<double, 4> volumes_ml() const {
+    const std::array<int64_t, 4> n = counts();
+    return {double(n[0]) * voxel_volume_ml(), double(n[1]) * voxel_volume_ml(), double(n[2]) * voxel_volume_ml(),
+            double(n[3]) * voxel_volume_ml()};
+  }
 };
 
 /// `rv` on its grid grown by `grow` (padded_geometry), as the padding is filled: −1000 HU, label 0,
