@@ -144,7 +144,6 @@ RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
 
 RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Volume& ct, const Volume* labels,
                          RenderRun run) {
-  fit_threads_to_load();
   RenderVolume volume = RenderVolume::from(ct, labels);
   volume.smoothing_mm = scene.render.smoothing_mm;
   return render_volumes(scene, opt, volume, std::move(run));
