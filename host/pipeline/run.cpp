@@ -186,7 +186,12 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
     rendered = render_volumes(scene, ro, views, what);
   } catch (...) {
     take_back();
-    write_warp(scene, w, o.out_dir, labels_out);
+    // The render's error is the one to report: a failure to write the warp's files is logged.
+    try {
+      write_warp(scene, w, o.out_dir, labels_out);
+    } catch (const std::exception& e) {
+      log::warn(std::string("the warp's files could not be written after the render failed: ") + e.what());
+    }
     throw;
   }
   take_back();
