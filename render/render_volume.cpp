@@ -11,6 +11,14 @@
 
 namespace pneumo {
 
+namespace {
+
+[[noreturn]] void refuse_label_value(double value) {
+  throw InputError("label map value " + std::to_string(value) + " is not an id from 0 to 65534");
+}
+
+}  // namespace
+
 RenderVolume RenderVolume::from(const Volume& ct, const Volume* labels) {
   return from_hu(ct.geometry(), ct.to_float32(), labels);
 }
@@ -47,10 +55,24 @@ RenderVolume RenderVolume::from_hu(const Geometry& g, std::vector<float>&& hu, c
         else v.labels[std::size_t(i)] = static_cast<uint16_t>(id);
       }
     });
-    if (first_bad < n)
-      throw InputError("label map value " + std::to_string(labels->value(first_bad)) + " is not an id from 0 to 65534");
+    if (first_bad < n) refuse_label_value(labels->value(first_bad));
   }
   v.hu = std::move(hu);   // last: a refused label map leaves the caller's values with it
+  return v;
+}
+
+RenderVolume RenderVolume::from_hu(const Geometry& g, std::vector<float>&& hu, std::vector<uint16_t> labels,
+                                   bool hu_is_int16) {
+  const int64_t n = int64_t(labels.size());
+  if (n != 0 && n != g.voxel_count())
+    throw std::invalid_argument("RenderVolume::from_hu: " + std::to_string(n) + " labels for " +
+                                std::to_string(g.voxel_count()) + " voxels");
+  int reserved = 0;
+#pragma omp parallel for schedule(static) reduction(| : reserved)
+  for (int64_t i = 0; i < n; ++i) reserved |= labels[std::size_t(i)] == kExteriorAirLabel;
+  if (reserved) refuse_label_value(kExteriorAirLabel);
+  RenderVolume v = from_hu(g, std::move(hu), nullptr, hu_is_int16);
+  v.labels = std::move(labels);
   return v;
 }
 

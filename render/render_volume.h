@@ -45,6 +45,10 @@ struct RenderVolume {
   /// The same when the caller knows whether every value fits_int16_texture (round_as_written says,
   /// in the pass that rounds them): the 10⁸ values are not read again.
   static RenderVolume from_hu(const Geometry& g, std::vector<float>&& hu, const Volume* labels, bool hu_is_int16);
+  /// The same with the labels already 16-bit ids on grid `g` (a run's warp holds them so; empty:
+  /// none), taken as they are: only kExteriorAirLabel, which the views reserve, is refused.
+  static RenderVolume from_hu(const Geometry& g, std::vector<float>&& hu, std::vector<uint16_t> labels,
+                              bool hu_is_int16);
 
   /// Labels air (HU ≤ threshold) connected to the grid's faces as kExteriorAirLabel (6-connected
   /// flood fill), creating an all-zero label map first when there is none. Exterior views hide it.

@@ -92,6 +92,25 @@ TEST(ViewsFromTheWarp, ADeformedCtWithoutItsHuIsRefused) {
   EXPECT_THROW(deformed_ct_volume(w), std::logic_error);
 }
 
+TEST(ViewsFromTheWarp, TheWarpsLabelsAreTakenAsTheyAreExceptTheReservedId) {
+  // The run gives the views the warp's 16-bit labels directly, not through the deformed label map.
+  Geometry g;
+  g.dims = {3, 2, 2};
+  const std::vector<float> hu(std::size_t(g.voxel_count()), -1000.0f);
+  std::vector<uint16_t> ids(std::size_t(g.voxel_count()), 0);
+  ids[3] = 250;
+  ids[7] = 65534;
+  const RenderVolume v = RenderVolume::from_hu(g, std::vector<float>(hu), ids, true);
+  EXPECT_EQ(v.labels, ids);
+  EXPECT_TRUE(RenderVolume::from_hu(g, std::vector<float>(hu), std::vector<uint16_t>{}, true).labels.empty());
+  ids[5] = kExteriorAirLabel;   // reserved for air outside the body
+  std::vector<float> kept = hu;
+  EXPECT_THROW(RenderVolume::from_hu(g, std::move(kept), ids, true), InputError);
+  EXPECT_EQ(kept.size(), hu.size());   // refused before the HU were taken
+  EXPECT_THROW(RenderVolume::from_hu(g, std::vector<float>(hu), std::vector<uint16_t>(5, 0), true),
+               std::invalid_argument);
+}
+
 TEST(ViewsFromTheWarp, ValuesForAnotherGridAreRefused) {
   Geometry g;
   g.dims = {4, 4, 4};

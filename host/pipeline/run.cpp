@@ -164,16 +164,12 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   RenderRun what;
   what.deformed = true;
   what.ct_path = (out / "deformed_ct.nii.gz").string();
-  std::optional<Volume> deformed_labels;
-  if (w.labels) {
-    deformed_labels = deformed_label_volume(w, scene.output.cavity_label);
-    what.labels_path = (out / "deformed_labels.nii.gz").string();
-  }
-  const Volume* const labels_out = deformed_labels ? &*deformed_labels : nullptr;
+  if (w.labels) what.labels_path = (out / "deformed_labels.nii.gz").string();
   // The views first, from memory, and the warp's files after them: a user waits for the first view,
   // not for deflating 10⁸ voxels. A render that fails still leaves the warp's files written.
   // The views take the warp's own HU, rounded as the file holds them (not a float copy of 10⁸
-  // voxels), and give them back for the deformed CT, built after the views.
+  // voxels), and give them back for the deformed CT, built after the views; and a copy of its
+  // 16-bit labels, which the deformed label map holds in its own type after the views.
   RenderRun rendered;
   RenderVolume views;
   const auto take_back = [&] {
@@ -181,24 +177,24 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   };
   try {
     const bool int16 = round_as_written(w.result.ct_hu, deformed_ct_type(w));
-    views = RenderVolume::from_hu(w.output_grid, std::move(w.result.ct_hu), labels_out, int16);
+    views = RenderVolume::from_hu(w.output_grid, std::move(w.result.ct_hu), w.result.labels, int16);
     views.smoothing_mm = scene.render.smoothing_mm;
     rendered = render_volumes(scene, ro, views, what);
   } catch (...) {
     take_back();
     // The render's error is the one to report: a failure to write the warp's files is logged.
     try {
-      write_warp(scene, w, o.out_dir, labels_out);
+      write_warp(scene, w, o.out_dir);
     } catch (const std::exception& e) {
       log::warn(std::string("the warp's files could not be written after the render failed: ") + e.what());
     }
     throw;
   }
   take_back();
-  views = RenderVolume();   // its labels' copy, before the deformed CT is built
+  views = RenderVolume();   // its labels' copy, before the deformed volumes are built
   const double seconds_render = seconds_since(t_render);
   log::info("writing the warped CT and labels");
-  write_warp(scene, w, o.out_dir, labels_out);
+  write_warp(scene, w, o.out_dir);
 
   // Report: landmarks, plots, metrics (complete), report.html last.
   log::info("stage 4/4: report");

@@ -398,7 +398,7 @@ class WarpOutputs {
 };
 }  // namespace
 
-void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir, const Volume* deformed_labels) {
+void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir) {
   nlohmann::json metrics = read_metrics(dir);
   check_writable_target(in_dir(dir, "metrics.json"));
   // An earlier warp replaced (--force) stops counting as finished before its images are replaced.
@@ -411,8 +411,7 @@ void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir,
   };
   if (scene.output.write_deformed_ct) write_volume(after_ct(), outputs.add("deformed_ct.nii.gz"));
   if (scene.output.write_deformed_labels && w.labels) {
-    write_volume(deformed_labels ? *deformed_labels : deformed_label_volume(w, scene.output.cavity_label),
-                 outputs.add("deformed_labels.nii.gz"));
+    write_volume(deformed_label_volume(w, scene.output.cavity_label), outputs.add("deformed_labels.nii.gz"));
     // Their names and colours, for 3D Slicer and ITK-SNAP.
     const std::vector<LabelTableEntry> rows = deformed_label_entries(scene, w);
     write_slicer_colour_table(outputs.add("deformed_labels.ctbl"), rows);

@@ -106,9 +106,7 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w);
 /// as the scene's output.write_* ask, then adds warp_metrics() to DIR/metrics.json: cavity_voxels
 /// and cavity_volume_ml become the warped cavity's, the mesh's own estimate stays as
 /// mesh_cavity_volume_ml. Every file is written atomically, metrics.json last.
-/// The deformed CT is built once, here. `deformed_labels`, when given, is deformed_label_volume(w, …)
-/// already built (the run renders it first): not built again.
-void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir,
-                const Volume* deformed_labels = nullptr);
+/// The deformed CT and label map are built here, once each.
+void write_warp(const Scene& scene, const WarpedCase& w, const std::string& dir);
 
 }  // namespace pneumo
