@@ -1,14 +1,46 @@
-// The tissue reflectance (render/tissue_reflectance.h) against truths outside the code:
+// The tissue colours (render/tissue_colour.h, render/tissue_reflectance.h) against truths outside
+// the code: the CIE's own chromaticities of its white points, the sRGB standard's transfer curve,
 // Chandrasekhar's exact albedo of an isotropically scattering half-space, and energy conservation.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
+#include "render/tissue_colour.h"
 #include "render/tissue_reflectance.h"
 
 namespace pneumo {
 namespace {
+
+Vec3 chromaticity(const Vec3& xyz) { return xyz / xyz.sum(); }
+
+// x̄, ȳ and z̄ enclose equal areas (CIE 015:2018 §3.1), so the equal-energy spectrum sits at (1/3, 1/3).
+// The table is every fifth row of the CIE's 1 nm table: 1e-5 allows the coarser sum.
+TEST(TissueColour, EqualEnergyWhiteIsAtOneThird) {
+  Vec3 xyz = Vec3::Zero();
+  for (const SpectralSample& s : kSpectralTable) xyz += Vec3(s.x_bar, s.y_bar, s.z_bar);
+  const Vec3 c = chromaticity(xyz);
+  EXPECT_NEAR(c.x(), 1.0 / 3.0, 1e-5);
+  EXPECT_NEAR(c.y(), 1.0 / 3.0, 1e-5);
+}
+
+// D65's white point as CIE 015:2018 Table 3 gives it for the 2° observer: (0.31272, 0.32903).
+TEST(TissueColour, D65WhiteIsTheCiesWhitePoint) {
+  const Vec3 c = chromaticity(xyz_under_d65([](const SpectralSample&) { return 1.0; }));
+  EXPECT_NEAR(c.x(), 0.31272, 5e-5);
+  EXPECT_NEAR(c.y(), 0.32903, 5e-5);
+}
+
+// A spectrally flat grey stays grey through the matrix and the white balance, and is encoded by
+// IEC 61966-2-1's curve: 1.055 · 0.18^(1/2.4) − 0.055 = 0.46135 for 18 % grey.
+TEST(TissueColour, GreyIsEncodedByTheSrgbCurve) {
+  const Vec3 rgb = display_srgb(xyz_under_d65([](const SpectralSample&) { return 0.18; }));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(rgb[c], 1.055 * std::pow(0.18, 1.0 / 2.4) - 0.055, 1e-9) << c;
+  const Vec3 lab = cielab(xyz_under_d65([](const SpectralSample&) { return 0.18; }));
+  EXPECT_NEAR(lab.x(), 116.0 * std::cbrt(0.18) - 16.0, 1e-9);  // L* of 18 % grey, 49.5
+  EXPECT_NEAR(lab.y(), 0.0, 1e-9);
+  EXPECT_NEAR(lab.z(), 0.0, 1e-9);
+}
 
 // Chandrasekhar's H-function for isotropic scattering of single-scattering albedo ω (Radiative
 // Transfer, 1950, Ch. V): H(μ) = 1 / (1 − (ω/2) μ ∫₀¹ H(μ′) / (μ + μ′) dμ′), solved by iteration
@@ -71,6 +103,20 @@ TEST(TissueReflectance, DiffusionTheoryHoldsOnlyWhereAbsorptionIsWeak) {
   }
   const double half = tissue_reflectance(1.0, 1.0);  // a′ = 0.5
   EXPECT_GT(diffusion_reflectance(0.5, kTissueRefractiveIndex), 1.5 * half);
+}
+
+// More blood, darker and redder: at fixed scattering, L* falls and a*/b* rises with B.
+TEST(TissueColour, MoreBloodIsDarkerAndRedder) {
+  TissueOptics t = tissue_optics(Tissue::Muscle);
+  double last_l = 100.0;
+  for (double b : {0.01, 0.05, 0.1, 0.3, 0.5}) {
+    t.blood = b;
+    const Vec3 lab = cielab(tissue_xyz(t));
+    EXPECT_LT(lab.x(), last_l) << b;
+    EXPECT_GT(lab.y(), 0.0) << b;
+    EXPECT_GT(lab.z(), 0.0) << b;
+    last_l = lab.x();
+  }
 }
 
 }  // namespace
