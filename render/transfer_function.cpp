@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "render/tissue_colour.h"
 #include "render/view_settings.h"
 
 namespace pneumo {
@@ -77,15 +78,23 @@ TransferFunction preset_transfer_function(RenderPreset preset) {
   TransferFunction tf;
   tf.name = enum_name(preset);
   switch (preset) {
-    case RenderPreset::Laparoscopic:
-      // Gas and air clear; fat pale yellow, muscle and organs in flesh tones getting darker red with
-      // density (liver ~60 HU deepest), bone off-white. Tissue reaches near-full opacity within
-      // 1-2 mm so surfaces look solid as they do through a laparoscope.
+    case RenderPreset::Laparoscopic: {
+      // Gas and air clear; tissue reaches near-full opacity within 1-2 mm so surfaces look solid
+      // as they do through a laparoscope. Colours are computed from the tissues' published optical
+      // make-up (render/tissue_colour.h): adipose tissue at fat's -100 HU, skeletal muscle at 40 HU,
+      // liver at 65 HU (unenhanced parenchyma), blended linearly between; bone off-white. Below
+      // -100 HU the colour darkens towards the -300 HU point, the partial-volume rim between gas
+      // and fat (clear below -160 HU, so it shows only as the edge of a surface).
       tf.opacity = {{-1024, 0}, {-300, 0}, {-160, 0}, {-110, 0.35}, {-60, 0.6}, {0, 0.8}, {40, 0.9}, {300, 1}};
-      tf.colour = {{-1024, 0.0, 0.0, 0.0},  {-300, 0.35, 0.28, 0.22}, {-100, 0.93, 0.80, 0.52},
-                   {-30, 0.90, 0.62, 0.50}, {20, 0.85, 0.42, 0.38},   {45, 0.75, 0.27, 0.24},
-                   {70, 0.60, 0.16, 0.14},  {250, 0.95, 0.88, 0.78},  {1000, 1.0, 0.98, 0.94}};
+      auto point = [](double hu, Tissue t) {
+        const Vec3 c = tissue_srgb(tissue_optics(t));
+        return std::array<double, 4>{hu, c.x(), c.y(), c.z()};
+      };
+      tf.colour = {{-1024, 0.0, 0.0, 0.0}, {-300, 0.35, 0.28, 0.22}, point(-100, Tissue::Adipose),
+                   point(40, Tissue::Muscle), point(65, Tissue::Liver), {250, 0.95, 0.88, 0.78},
+                   {1000, 1.0, 0.98, 0.94}};
       break;
+    }
     case RenderPreset::CtSoftTissue:  // Slicer "CT-Soft-Tissue"
       tf.opacity = {{-2048, 0}, {-167.01, 0}, {-160, 1}, {240, 1}, {3071, 1}};
       tf.colour = {{-2048, 0, 0, 0}, {-167.01, 0, 0, 0}, {-160, 0.0556, 0.0556, 0.0556}, {240, 1, 1, 1}, {3071, 1, 1, 1}};
@@ -124,6 +133,25 @@ TransferFunction preset_transfer_function(RenderPreset preset) {
       throw InputError("the \"custom\" preset takes its points from render.custom_opacity and custom_colour");
   }
   return tf;
+}
+
+LabelColours preset_label_colours(RenderPreset preset) {
+  LabelColours c = default_label_colours();
+  if (preset != RenderPreset::Laparoscopic) return c;
+  // Organs whose optical make-up is published take their computed colour (render/tissue_colour.h);
+  // the rest keep the identifying colours of default_label_colours().
+  auto set = [&](std::initializer_list<int> ids, Tissue t) {
+    const Vec3 rgb = tissue_srgb(tissue_optics(t));
+    for (int id : ids)
+      c.rgba[std::size_t(id)] = {uint8_t(std::lround(255.0 * rgb.x())), uint8_t(std::lround(255.0 * rgb.y())),
+                                 uint8_t(std::lround(255.0 * rgb.z())), 255};
+  };
+  set({5}, Tissue::Liver);
+  set({2, 3}, Tissue::Kidney);
+  set({7}, Tissue::Pancreas);
+  set({18, 19}, Tissue::SmallBowel);
+  set({20}, Tissue::Colon);
+  return c;
 }
 
 TransferFunction scene_transfer_function(const ViewSettings& render) {

@@ -1,7 +1,7 @@
 #pragma once
 // Transfer functions (method.md §8): HU → colour and opacity, piecewise linear between points,
 // constant beyond the first and last point. Presets follow 3D Slicer's CT set (presets.xml);
-// "laparoscopic" is pneumo's own (tissue in flesh tones, gas clear). Opacities are per 1 mm of
+// "laparoscopic" is pneumo's own (tissue colours computed from published optical properties, gas clear). Opacities are per 1 mm of
 // ray (the opacity unit distance, as in VTK/Slicer); the ray casters correct them for their step:
 // α′ = 1 − (1 − α)^(Δs / 1 mm).
 #include <array>
@@ -10,6 +10,7 @@
 
 #include "core/geometry.h"
 #include "domain/types.h"
+#include "render/render_volume.h"
 #include "render/view_settings.h"
 
 namespace pneumo {
@@ -31,6 +32,10 @@ struct TransferFunction {
 
 /// A named preset.
 TransferFunction preset_transfer_function(RenderPreset preset);
+
+/// The organ colours a preset blends over its transfer function's: default_label_colours(), and
+/// for "laparoscopic" the computed colours of the organs render/tissue_colour.h models.
+LabelColours preset_label_colours(RenderPreset preset);
 
 /// The scene's choice: render.preset, or the points of render.custom_opacity / custom_colour
 /// when the preset is "custom".

@@ -226,13 +226,25 @@ TEST(RenderReference, TheFirstSurfaceFollowsTheWallNotTheSampleLattice) {
   EXPECT_LT(hi - lo, 0.4 * s.step_mm);
 }
 
+// The laparoscopic preset's opacities under a high-contrast colour ramp (bright fat at -100 HU over
+// a dark rim at -300 HU, deep red at 70 HU: the preset's hand-picked colours before they were
+// computed from tissue optics): the two tests below compare opacity, which shows most where bright
+// and dark tissue are composited, whatever colours the preset now has.
+TransferFunction laparoscopic_opacity_high_contrast() {
+  TransferFunction tf = preset_transfer_function(RenderPreset::Laparoscopic);
+  tf.colour = {{-1024, 0.0, 0.0, 0.0},  {-300, 0.35, 0.28, 0.22}, {-100, 0.93, 0.80, 0.52},
+               {-30, 0.90, 0.62, 0.50}, {20, 0.85, 0.42, 0.38},   {45, 0.75, 0.27, 0.24},
+               {70, 0.60, 0.16, 0.14},  {250, 0.95, 0.88, 0.78},  {1000, 1.0, 0.98, 0.94}};
+  return tf;
+}
+
 // Opacity correction: the same view at Δs = 0.75 and 0.375 mm differs only by where samples fall
 // (≥ 30 dB); without the correction (α used per sample) the finer step would be visibly more
 // opaque and brighter on semi-transparent fat. Checked by the corrected pair beating 30 dB.
 TEST(RenderReference, OpacityCorrectionMakesTheImageIndependentOfTheStep) {
   const RenderVolume v = make_cavity_phantom();
   RenderSettings s;
-  s.tf = preset_transfer_function(RenderPreset::Laparoscopic);
+  s.tf = laparoscopic_opacity_high_contrast();
   const ViewCamera c = camera(Vec3(0, 20, 0), Vec3(0, -30, 0), Optics{}, 48, 48);
   s.step_mm = 0.75;
   const RenderImage a = render_reference(v, c, s);
@@ -249,7 +261,7 @@ TEST(RenderReference, WithoutOpacityCorrectionTheStepWouldShow) {
   const ViewCamera c = camera(Vec3(0, 20, 0), Vec3(0, -30, 0), Optics{}, 48, 48);
   auto uncorrected = [&](double step_mm) {
     RenderSettings s;
-    s.tf = preset_transfer_function(RenderPreset::Laparoscopic);
+    s.tf = laparoscopic_opacity_high_contrast();
     for (auto& point : s.tf.opacity) point[1] = 1.0 - std::pow(1.0 - point[1], kOpacityUnitMm / step_mm);
     s.step_mm = step_mm;
     return render_reference(v, c, s);

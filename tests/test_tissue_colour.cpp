@@ -8,6 +8,7 @@
 
 #include "render/tissue_colour.h"
 #include "render/tissue_reflectance.h"
+#include "render/transfer_function.h"
 
 namespace pneumo {
 namespace {
@@ -117,6 +118,23 @@ TEST(TissueColour, MoreBloodIsDarkerAndRedder) {
     EXPECT_GT(lab.z(), 0.0) << b;
     last_l = lab.x();
   }
+}
+
+// The laparoscopic preset's colours are the computed ones, at the HU and label ids it names; the
+// other presets keep the identifying organ colours.
+TEST(TissueColour, LaparoscopicPresetTakesTheComputedColours) {
+  const TransferFunction tf = preset_transfer_function(RenderPreset::Laparoscopic);
+  const std::pair<double, Tissue> points[] = {{-100, Tissue::Adipose}, {40, Tissue::Muscle}, {65, Tissue::Liver}};
+  for (const auto& [hu, tissue] : points) {
+    const Vec3 want = tissue_srgb(tissue_optics(tissue));
+    EXPECT_LT((tf.colour_at(hu) - want).norm(), 1e-12) << hu;
+  }
+  const LabelColours lap = preset_label_colours(RenderPreset::Laparoscopic);
+  const Vec3 liver = 255.0 * tissue_srgb(tissue_optics(Tissue::Liver));
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(int(lap.rgba[5][c]), int(std::lround(liver[c])));
+  const LabelColours slicer = preset_label_colours(RenderPreset::CtSoftTissue);
+  EXPECT_EQ(slicer.rgba[5], default_label_colours().rgba[5]);
+  EXPECT_EQ(lap.rgba[52], default_label_colours().rgba[52]);  // the aorta: no published make-up here
 }
 
 }  // namespace

@@ -74,6 +74,7 @@ RenderSettings settings_from_scene(const ViewSettings& r, const Geometry& g) {
   s.jitter = r.jitter;
   s.show_labels = r.show_labels;
   s.label_opacity = r.label_opacity;
+  s.label_colours = preset_label_colours(r.preset);
   s.ambient = r.ambient;
   s.diffuse = r.diffuse;
   s.specular = r.specular;

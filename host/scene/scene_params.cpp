@@ -374,8 +374,9 @@ const Table<ViewSettings>& render_table() {
       {"width", &ViewSettings::width, "px", in(16, 8192), "Image width."},
       {"height", &ViewSettings::height, "px", in(16, 8192), "Image height."},
       {"preset", &ViewSettings::preset, "", any(),
-       "Transfer function (§8): \"laparoscopic\" (flesh tones, gas clear), one of 3D Slicer's CT presets, \"skin\" "
-       "(the body's surface, as the exterior views show it) or \"custom\" (the two lists below)."},
+       "Transfer function (§8): \"laparoscopic\" (tissue colours computed from published optical properties, "
+       "gas clear), one of 3D Slicer's CT presets, \"skin\" (the body's surface, as the exterior views show it) "
+       "or \"custom\" (the two lists below)."},
       {"custom_opacity", &ViewSettings::custom_opacity, "", any().rule("pairs [HU, opacity 0 to 1], HU non-decreasing", is_opacity_points),
        "Preset \"custom\": opacity per 1 mm of ray at HU points, [HU, α, HU, α, ...]; linear between, constant beyond."},
       {"custom_colour", &ViewSettings::custom_colour, "", any().rule("quadruples [HU, r, g, b], components 0 to 1, HU non-decreasing", is_colour_points),
