@@ -77,8 +77,8 @@ Vec3 tissue_srgb(const TissueOptics& t) { return display_srgb(tissue_xyz(t)); }
 // The make-up of each tissue, from S. L. Jacques, "Optical properties of biological tissues: a
 // review", Phys. Med. Biol. 58 (2013) R37:
 // - scattering: Table 2's means, "fatty tissue" (a = 18.4 cm⁻¹, b = 0.672) for fat and "other soft
-//   tissues" (a = 18.9 cm⁻¹, b = 1.286) for the rest; Table 1's single-organ fits (liver 9.0 to
-//   16.5 cm⁻¹) scatter around the latter, so one mean serves every organ;
+//   tissues" (a = 18.9 cm⁻¹, b = 1.286) for the rest. Table 1's fits for the liver alone (a = 9.0
+//   and 16.5 cm⁻¹) lie below the mean: with them the liver would come out darker still;
 // - adipose tissue: Table 3's only human abdominal row, in vivo (Jakubowski et al. 2004, J. Biomed.
 //   Opt. 9:230): B = 0.54 %, S = 76 %, W = 11 %, F = 69 %;
 // - bowel and kidney: Table 3's optical measurements in vivo (Solonenko et al. 2002, Phys. Med.
