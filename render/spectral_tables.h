@@ -12,6 +12,7 @@ struct SpectralSample {
   double d65;                  // CIE standard illuminant D65, relative spectral power (100 at 560 nm)
   double hbo2, hb;             // molar extinction of oxy- and deoxyhaemoglobin, decadic, mm⁻¹ per µM
   double water, fat;           // absorption coefficient of pure water and of pure fat, mm⁻¹
+  double beta_carotene;        // molar extinction of β-carotene, decadic, mm⁻¹ per µM
 };
 
 inline constexpr int kSpectralSamples = 81;

@@ -9,7 +9,7 @@ namespace pneumo {
 double absorption_per_mm(const TissueOptics& t, const SpectralSample& s) {
   const double blood = std::log(10.0) * kWholeBloodHaemoglobinMicroMolar *
                        (t.saturation * s.hbo2 + (1.0 - t.saturation) * s.hb);
-  return t.blood * blood + t.water * s.water + t.fat * s.fat;
+  return t.blood * blood + t.water * s.water + t.fat * s.fat + std::log(10.0) * s.beta_carotene * t.beta_carotene_um;
 }
 
 double reduced_scattering_per_mm(const TissueOptics& t, double nm) {
@@ -80,7 +80,11 @@ Vec3 tissue_srgb(const TissueOptics& t) { return display_srgb(tissue_xyz(t)); }
 //   tissues" (a = 18.9 cm⁻¹, b = 1.286) for the rest. Table 1's fits for the liver alone (a = 9.0
 //   and 16.5 cm⁻¹) lie below the mean: with them the liver would come out darker still;
 // - adipose tissue: Table 3's only human abdominal row, in vivo (Jakubowski et al. 2004, J. Biomed.
-//   Opt. 9:230): B = 0.54 %, S = 76 %, W = 11 %, F = 69 %;
+//   Opt. 9:230): B = 0.54 %, S = 76 %, W = 11 %, F = 69 %; β-carotene 1472 nmol/kg, abdominal
+//   adipose tissue by HPLC of biopsies (Chung et al. 2009, Am. J. Clin. Nutr. 90:533), taken as
+//   1.47 µmol per litre (adipose tissue's density, about 0.9 kg/l, would lower it by a tenth). The
+//   other carotenoids there (lycopene 3.3, lutein 0.46, α-carotene 0.28 µmol/kg, ibid.) have no
+//   openly licensed spectrum here: fat's yellow is understated;
 // - bowel and kidney: Table 3's optical measurements in vivo (Solonenko et al. 2002, Phys. Med.
 //   Biol. 47:857, canine): bowel B = 5.11 %, S = 80 % (small bowel and colon alike), kidney
 //   B = 14.61 %, S = 70 %;
@@ -91,14 +95,14 @@ Vec3 tissue_srgb(const TissueOptics& t) { return display_srgb(tissue_xyz(t)); }
 //   human in vivo abdominal value above. W = 75 % for every organ, lean tissue's water (its
 //   absorption, under 0.003 mm⁻¹ from 380 to 780 nm, is under 1 % of the blood's: the colour does
 //   not depend on it).
-// Not modelled: bile and β-carotene (no openly licensed spectra of their in vivo forms; fat's
-// yellow and the liver's brown are therefore weaker than in life), and the packaging of blood in
+// Not modelled: bile (no openly licensed spectrum of its in vivo form; the liver's brown is weaker
+// than in life), β-carotene's shift from hexane to fat (a few nm), and the packaging of blood in
 // vessels (it lowers the effective absorption of large vessels, not of capillaries and sinusoids).
 const TissueOptics& tissue_optics(Tissue t) {
-  static const TissueOptics adipose{"adipose tissue", 0.0054, 0.76, 0.11, 0.69, 18.4, 0.672,
-                                    "Jacques 2013 Tables 2 and 3 (Jakubowski et al. 2004)"};
+  static const TissueOptics adipose{"adipose tissue", 0.0054, 0.76, 0.11, 0.69, 1.472, 18.4, 0.672,
+                                    "Jacques 2013 Tables 2 and 3 (Jakubowski et al. 2004); Chung et al. 2009"};
   auto organ = [](const char* name, double blood, double saturation, const char* source) {
-    return TissueOptics{name, blood, saturation, 0.75, 0.0, 18.9, 1.286, source};
+    return TissueOptics{name, blood, saturation, 0.75, 0.0, 0.0, 18.9, 1.286, source};
   };
   static const TissueOptics muscle = organ("skeletal muscle", 0.0116, 0.76, "Jacques 2013 Tables 2 and 3 (Weaver et al. 1989)");
   static const TissueOptics liver = organ("liver", 0.495, 0.76, "Jacques 2013 Tables 2 and 3 (Weaver et al. 1989)");

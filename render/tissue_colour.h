@@ -3,8 +3,9 @@
 // laparoscopic preset's flesh tones are computed, not picked by eye. The chain, each step a
 // published model:
 //  1. absorption μa(λ) = B·S·μa,oxy(λ) + B·(1−S)·μa,deoxy(λ) + W·μa,water(λ) + F·μa,fat(λ)
-//     (Jacques 2013, Phys. Med. Biol. 58 R37, Eq. 12), whole blood at 150 g/l haemoglobin
-//     (2326 µM of tetramer, 64 500 g/mol): μa,blood = ln 10 · ε(λ) · 2326 µM;
+//     + ln 10 · εβC(λ) · CβC (Jacques 2013, Phys. Med. Biol. 58 R37, Eq. 12, with its yellow
+//     pigment β-carotene), whole blood at 150 g/l haemoglobin (2326 µM of tetramer, 64 500 g/mol):
+//     μa,blood = ln 10 · ε(λ) · 2326 µM;
 //  2. reduced scattering μs′(λ) = a·(λ / 500 nm)^−b (ibid., Eq. 1);
 //  3. the diffuse reflectance of a thick tissue: the transport equation's answer for its albedo
 //     μs′/(μa+μs′) (render/tissue_reflectance.h: Monte Carlo, tabulated; g = 0.9, n = 1.4);
@@ -29,6 +30,7 @@ struct TissueOptics {
   double saturation = 0.0;     // S: haemoglobin oxygen saturation
   double water = 0.0;          // W
   double fat = 0.0;            // F
+  double beta_carotene_um = 0.0;  // β-carotene, µmol per litre of tissue
   double scatter_a_per_cm = 0;  // μs′ at 500 nm, cm⁻¹
   double scatter_b = 0.0;      // the power law's exponent
   std::string source;          // where the numbers were published

@@ -106,6 +106,30 @@ TEST(TissueReflectance, DiffusionTheoryHoldsOnlyWhereAbsorptionIsWeak) {
   EXPECT_GT(diffusion_reflectance(0.5, kTissueRefractiveIndex), 1.5 * half);
 }
 
+// β-carotene's column: its absorption maximum in hexane lies at 450 ± 5 nm, where its specific
+// absorbance A(1 %, 1 cm) = 2592 (Britton 1995, Carotenoids 1B) gives ε = 2592 · 536.9 / 10 =
+// 139 160 cm⁻¹/M = 0.01392 mm⁻¹/µM; 3 % allows the 5 nm average over the peak. Nothing above 530 nm.
+TEST(TissueColour, BetaCaroteneAbsorbsWhereAndAsMuchAsItsStandard) {
+  const SpectralSample* peak = &kSpectralTable[0];
+  for (const SpectralSample& s : kSpectralTable) {
+    if (s.beta_carotene > peak->beta_carotene) peak = &s;
+    if (s.nm > 530) EXPECT_EQ(s.beta_carotene, 0.0) << s.nm;
+  }
+  EXPECT_NEAR(peak->nm, 450, 5);
+  EXPECT_NEAR(peak->beta_carotene, 2592.0 * 536.87 / 10.0 * 1e-7, 0.03 * 0.01392);
+}
+
+// A yellow pigment absorbs blue: with β-carotene, fat's b* rises, its lightness hardly moves.
+TEST(TissueColour, BetaCaroteneTurnsFatYellow) {
+  TissueOptics fat = tissue_optics(Tissue::Adipose);
+  fat.beta_carotene_um = 0.0;
+  const Vec3 without = cielab(tissue_xyz(fat));
+  fat.beta_carotene_um = 6.0;
+  const Vec3 with = cielab(tissue_xyz(fat));
+  EXPECT_GT(with.z(), without.z() + 5.0);
+  EXPECT_NEAR(with.x(), without.x(), 2.0);
+}
+
 // More blood, darker and redder: at fixed scattering, L* falls and a*/b* rises with B.
 TEST(TissueColour, MoreBloodIsDarkerAndRedder) {
   TissueOptics t = tissue_optics(Tissue::Muscle);
