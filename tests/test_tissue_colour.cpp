@@ -113,7 +113,9 @@ TEST(TissueColour, BetaCaroteneAbsorbsWhereAndAsMuchAsItsStandard) {
   const SpectralSample* peak = &kSpectralTable[0];
   for (const SpectralSample& s : kSpectralTable) {
     if (s.beta_carotene > peak->beta_carotene) peak = &s;
-    if (s.nm > 530) EXPECT_EQ(s.beta_carotene, 0.0) << s.nm;
+    if (s.nm > 530) {
+      EXPECT_EQ(s.beta_carotene, 0.0) << s.nm;
+    }
   }
   EXPECT_NEAR(peak->nm, 450, 5);
   EXPECT_NEAR(peak->beta_carotene, 2592.0 * 536.87 / 10.0 * 1e-7, 0.03 * 0.01392);
