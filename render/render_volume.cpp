@@ -302,23 +302,44 @@ bool RenderVolume::contains(const Vec3& world_mm) const {
   return true;
 }
 
+const std::vector<int>& organ_label_ids(ColouredOrgan organ) {
+  static const std::vector<int> liver{5}, kidneys{2, 3}, arteries{52, 65, 66} /* aorta, iliac arteries */,
+      veins{63, 64, 67, 68} /* inferior vena cava, portal vein, iliac veins */, spleen{1}, gallbladder{4}, stomach{6},
+      pancreas{7}, small_bowel{18, 19} /* and duodenum */, colon{20};
+  switch (organ) {
+    case ColouredOrgan::Liver: return liver;
+    case ColouredOrgan::Kidneys: return kidneys;
+    case ColouredOrgan::Arteries: return arteries;
+    case ColouredOrgan::Veins: return veins;
+    case ColouredOrgan::Spleen: return spleen;
+    case ColouredOrgan::Gallbladder: return gallbladder;
+    case ColouredOrgan::Stomach: return stomach;
+    case ColouredOrgan::Pancreas: return pancreas;
+    case ColouredOrgan::SmallBowel: return small_bowel;
+    case ColouredOrgan::Colon: return colon;
+  }
+  throw std::logic_error("organ_label_ids: unknown organ");
+}
+
+void set_organ_colour(LabelColours& c, ColouredOrgan organ, uint8_t r, uint8_t g, uint8_t b) {
+  for (int id : organ_label_ids(organ)) c.rgba[std::size_t(id)] = {r, g, b, 255};
+}
+
 LabelColours default_label_colours() {
   LabelColours c;
-  auto set = [&](std::initializer_list<int> ids, uint8_t r, uint8_t g, uint8_t b) {
-    for (int id : ids) c.rgba[id] = {r, g, b, 255};
-  };
   // Kitasaka 2004 Fig. 6: liver dark red, kidneys yellow, aorta green; the rest chosen to stay
   // apart from those and from the flesh tones of the transfer function.
-  set({5}, 110, 10, 10);           // liver
-  set({2, 3}, 235, 205, 30);       // kidneys
-  set({52, 65, 66}, 30, 170, 60);  // aorta, iliac arteries
-  set({63, 64, 67, 68}, 40, 80, 200);  // inferior vena cava, portal vein, iliac veins
-  set({1}, 150, 60, 160);          // spleen
-  set({4}, 90, 160, 40);           // gallbladder
-  set({6}, 230, 140, 150);         // stomach
-  set({7}, 240, 150, 40);          // pancreas
-  set({18, 19}, 250, 190, 170);    // small bowel, duodenum
-  set({20}, 200, 150, 110);        // colon
+  using O = ColouredOrgan;
+  set_organ_colour(c, O::Liver, 110, 10, 10);
+  set_organ_colour(c, O::Kidneys, 235, 205, 30);
+  set_organ_colour(c, O::Arteries, 30, 170, 60);
+  set_organ_colour(c, O::Veins, 40, 80, 200);
+  set_organ_colour(c, O::Spleen, 150, 60, 160);
+  set_organ_colour(c, O::Gallbladder, 90, 160, 40);
+  set_organ_colour(c, O::Stomach, 230, 140, 150);
+  set_organ_colour(c, O::Pancreas, 240, 150, 40);
+  set_organ_colour(c, O::SmallBowel, 250, 190, 170);
+  set_organ_colour(c, O::Colon, 200, 150, 110);
   return c;
 }
 

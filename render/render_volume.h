@@ -137,7 +137,15 @@ struct LabelColours {
   std::vector<std::array<uint8_t, 4>> rgba = std::vector<std::array<uint8_t, 4>>(65536, {0, 0, 0, 0});
 };
 
-/// The colours pneumo uses for TotalSegmentator ids (and the phantom's own ids from 200 up).
+/// The organs the views colour, and their TotalSegmentator ids (the phantom paints the same ids).
+enum class ColouredOrgan { Liver, Kidneys, Arteries, Veins, Spleen, Gallbladder, Stomach, Pancreas, SmallBowel, Colon };
+const std::vector<int>& organ_label_ids(ColouredOrgan organ);
+
+/// Gives every id of `organ` the opaque colour (r, g, b).
+void set_organ_colour(LabelColours& c, ColouredOrgan organ, uint8_t r, uint8_t g, uint8_t b);
+
+/// The identifying colours pneumo gives the coloured organs (every preset but "laparoscopic"'s
+/// modelled tissues, render/transfer_function.h).
 LabelColours default_label_colours();
 
 /// A label's colour as the views interpolate it (render_settings.h, model step 3): rgb premultiplied

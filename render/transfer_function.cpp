@@ -140,17 +140,16 @@ LabelColours preset_label_colours(RenderPreset preset) {
   if (preset != RenderPreset::Laparoscopic) return c;
   // Organs whose optical make-up is published take their computed colour (render/tissue_colour.h);
   // the rest keep the identifying colours of default_label_colours().
-  auto set = [&](std::initializer_list<int> ids, Tissue t) {
+  auto set = [&](ColouredOrgan organ, Tissue t) {
     const Vec3 rgb = tissue_srgb(tissue_optics(t));
-    for (int id : ids)
-      c.rgba[std::size_t(id)] = {uint8_t(std::lround(255.0 * rgb.x())), uint8_t(std::lround(255.0 * rgb.y())),
-                                 uint8_t(std::lround(255.0 * rgb.z())), 255};
+    auto byte = [](double v) { return uint8_t(std::lround(255.0 * v)); };
+    set_organ_colour(c, organ, byte(rgb.x()), byte(rgb.y()), byte(rgb.z()));
   };
-  set({5}, Tissue::Liver);
-  set({2, 3}, Tissue::Kidney);
-  set({7}, Tissue::Pancreas);
-  set({18, 19}, Tissue::SmallBowel);
-  set({20}, Tissue::Colon);
+  set(ColouredOrgan::Liver, Tissue::Liver);
+  set(ColouredOrgan::Kidneys, Tissue::Kidney);
+  set(ColouredOrgan::Pancreas, Tissue::Pancreas);
+  set(ColouredOrgan::SmallBowel, Tissue::SmallBowel);
+  set(ColouredOrgan::Colon, Tissue::Colon);
   return c;
 }
 
