@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-
+#include <stdexcept>
 
 namespace pneumo {
 
@@ -86,7 +86,7 @@ Vec3 tissue_srgb(const TissueOptics& t) { return display_srgb(tissue_xyz(t)); }
 //   other carotenoids there (lycopene 3.3, lutein 0.46, α-carotene 0.28 µmol/kg, ibid.) have no
 //   openly licensed spectrum here: fat's yellow is understated;
 // - bowel and kidney: Table 3's optical measurements in vivo (Solonenko et al. 2002, Phys. Med.
-//   Biol. 47:857, canine): bowel B = 5.11 %, S = 80 % (small bowel and colon alike), kidney
+//   Biol. 47:857, canine): bowel B = 5.11 %, S = 80 % (small bowel and colon), kidney
 //   B = 14.61 %, S = 70 %;
 // - muscle, pancreas, liver: no optical row, so Table 3's whole-organ blood volume fractions of
 //   Weaver et al. 1989 (Comp. Biochem. Physiol. A 94:401, sheep and horse): 1.16 %, 12.9 %, 49.5 %.
@@ -99,27 +99,20 @@ Vec3 tissue_srgb(const TissueOptics& t) { return display_srgb(tissue_xyz(t)); }
 // than in life), β-carotene's shift from hexane to fat (a few nm), and the packaging of blood in
 // vessels (it lowers the effective absorption of large vessels, not of capillaries and sinusoids).
 const TissueOptics& tissue_optics(Tissue t) {
-  static const TissueOptics adipose{"adipose tissue", 0.0054, 0.76, 0.11, 0.69, 1.472, 18.4, 0.672,
-                                    "Jacques 2013 Tables 2 and 3 (Jakubowski et al. 2004); Chung et al. 2009"};
-  auto organ = [](const char* name, double blood, double saturation, const char* source) {
-    return TissueOptics{name, blood, saturation, 0.75, 0.0, 0.0, 18.9, 1.286, source};
-  };
-  static const TissueOptics muscle = organ("skeletal muscle", 0.0116, 0.76, "Jacques 2013 Tables 2 and 3 (Weaver et al. 1989)");
-  static const TissueOptics liver = organ("liver", 0.495, 0.76, "Jacques 2013 Tables 2 and 3 (Weaver et al. 1989)");
-  static const TissueOptics small_bowel = organ("small bowel", 0.0511, 0.80, "Jacques 2013 Tables 2 and 3 (Solonenko et al. 2002)");
-  static const TissueOptics colon = organ("colon", 0.0511, 0.80, "Jacques 2013 Tables 2 and 3 (Solonenko et al. 2002)");
-  static const TissueOptics pancreas = organ("pancreas", 0.129, 0.76, "Jacques 2013 Tables 2 and 3 (Weaver et al. 1989)");
-  static const TissueOptics kidney = organ("kidney", 0.1461, 0.70, "Jacques 2013 Tables 2 and 3 (Solonenko et al. 2002)");
+  // {B, S, W, F, β-carotene µM, a cm⁻¹, b}
+  static const TissueOptics adipose{0.0054, 0.76, 0.11, 0.69, 1.472, 18.4, 0.672};
+  auto organ = [](double blood, double saturation) { return TissueOptics{blood, saturation, 0.75, 0.0, 0.0, 18.9, 1.286}; };
+  static const TissueOptics muscle = organ(0.0116, 0.76), liver = organ(0.495, 0.76), bowel = organ(0.0511, 0.80),
+                            pancreas = organ(0.129, 0.76), kidney = organ(0.1461, 0.70);
   switch (t) {
     case Tissue::Adipose: return adipose;
     case Tissue::Muscle: return muscle;
     case Tissue::Liver: return liver;
-    case Tissue::SmallBowel: return small_bowel;
-    case Tissue::Colon: return colon;
+    case Tissue::Bowel: return bowel;
     case Tissue::Pancreas: return pancreas;
     case Tissue::Kidney: return kidney;
   }
-  return muscle;
+  throw std::logic_error("tissue_optics: unknown tissue");
 }
 
 }  // namespace pneumo

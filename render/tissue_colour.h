@@ -15,7 +15,6 @@
 // The surface's own gloss (the Fresnel reflection, about 3 % at n = 1.4) is not in R: the ray
 // caster adds it as its specular highlight.
 #include <functional>
-#include <string>
 
 #include "core/geometry.h"
 #include "render/spectral_tables.h"
@@ -25,15 +24,13 @@ namespace pneumo {
 
 /// A tissue's optical make-up: volume fractions (0 to 1) and its scattering power law.
 struct TissueOptics {
-  std::string name;
-  double blood = 0.0;          // B: volume fraction of whole blood
-  double saturation = 0.0;     // S: haemoglobin oxygen saturation
-  double water = 0.0;          // W
-  double fat = 0.0;            // F
+  double blood = 0.0;             // B: volume fraction of whole blood
+  double saturation = 0.0;        // S: haemoglobin oxygen saturation
+  double water = 0.0;             // W
+  double fat = 0.0;               // F
   double beta_carotene_um = 0.0;  // β-carotene, µmol per litre of tissue
-  double scatter_a_per_cm = 0;  // μs′ at 500 nm, cm⁻¹
-  double scatter_b = 0.0;      // the power law's exponent
-  std::string source;          // where the numbers were published
+  double scatter_a_per_cm = 0.0;  // μs′ at 500 nm, cm⁻¹
+  double scatter_b = 0.0;         // the power law's exponent
 };
 
 inline constexpr double kWholeBloodHaemoglobinMicroMolar = 150.0 / 64500.0 * 1e6;
@@ -58,7 +55,7 @@ Vec3 tissue_srgb(const TissueOptics& t);
 
 /// The tissues the laparoscopic preset colours, each with its published make-up (tissue_colour.cpp
 /// says where each number was published and what was assumed).
-enum class Tissue { Adipose, Muscle, Liver, SmallBowel, Colon, Pancreas, Kidney };
+enum class Tissue { Adipose, Muscle, Liver, Bowel, Pancreas, Kidney };
 const TissueOptics& tissue_optics(Tissue t);
 
 }  // namespace pneumo

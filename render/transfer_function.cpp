@@ -148,8 +148,8 @@ LabelColours preset_label_colours(RenderPreset preset) {
   set(ColouredOrgan::Liver, Tissue::Liver);
   set(ColouredOrgan::Kidneys, Tissue::Kidney);
   set(ColouredOrgan::Pancreas, Tissue::Pancreas);
-  set(ColouredOrgan::SmallBowel, Tissue::SmallBowel);
-  set(ColouredOrgan::Colon, Tissue::Colon);
+  set(ColouredOrgan::SmallBowel, Tissue::Bowel);
+  set(ColouredOrgan::Colon, Tissue::Bowel);
   return c;
 }
 
