@@ -78,13 +78,6 @@ ReflectanceEstimate monte_carlo_reflectance(double albedo, double g, double n, i
   return {mean, std::sqrt(var)};
 }
 
-double diffusion_reflectance(double albedo, double n) {
-  const double r = -1.4399 / (n * n) + 0.7099 / n + 0.6681 + 0.0636 * n;
-  const double A = (1.0 + r) / (1.0 - r);
-  const double s = std::sqrt(3.0 * (1.0 - albedo));
-  return 0.5 * albedo * (1.0 + std::exp(-4.0 / 3.0 * A * s)) * std::exp(-s);
-}
-
 // monte_carlo_reflectance(1 − s²/3, kTissueAnisotropy, kTissueRefractiveIndex, N, 1000 + k) at
 // s = k·√3/32, N = 50 000 photons for k = 1 to 3 (the slowest: packets scatter thousands of times
 // before they leave), 200 000 for the rest; k = 0 (no absorption) returns everything, k = 32 (no

@@ -29,10 +29,6 @@ struct ReflectanceEstimate {
 };
 ReflectanceEstimate monte_carlo_reflectance(double albedo, double g, double n, int64_t photons, uint64_t seed);
 
-/// Diffusion theory (Farrell et al. 1992, total diffuse reflectance with an index-mismatched
-/// boundary, A from Groenhuis et al. 1983): the closed form the table is checked against as a′ → 1.
-double diffusion_reflectance(double albedo, double n);
-
 /// The table: monte_carlo_reflectance(a′, 0.9, 1.4) at s = √(3(1 − a′)) = k·√3/32, k = 0 … 32,
 /// interpolated linearly in s (the reflectance is smooth in s; it has a square-root cusp in a′).
 inline constexpr int kReflectanceTableSize = 33;

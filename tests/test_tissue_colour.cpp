@@ -94,7 +94,16 @@ TEST(TissueReflectance, TableIsTheMonteCarloAtTissuesAnisotropy) {
   }
 }
 
-// Diffusion theory (Farrell et al. 1992) is the transport equation's limit as absorption vanishes:
+// Diffusion theory's total diffuse reflectance of a half-space with an index-mismatched boundary
+// (Farrell, Patterson & Wilson 1992, Med. Phys. 19:879; A from Groenhuis et al. 1983).
+double diffusion_reflectance(double albedo, double n) {
+  const double r = -1.4399 / (n * n) + 0.7099 / n + 0.6681 + 0.0636 * n;
+  const double A = (1.0 + r) / (1.0 - r);
+  const double s = std::sqrt(3.0 * (1.0 - albedo));
+  return 0.5 * albedo * (1.0 + std::exp(-4.0 / 3.0 * A * s)) * std::exp(-s);
+}
+
+// Diffusion theory is the transport equation's limit as absorption vanishes:
 // within 2 % of the table for a′ ≥ 0.98, and far above it where blood absorbs (a′ = 0.5, the green
 // of liver), which is why the colours take the table.
 TEST(TissueReflectance, DiffusionTheoryHoldsOnlyWhereAbsorptionIsWeak) {
@@ -132,8 +141,9 @@ TEST(TissueColour, BetaCaroteneTurnsFatYellow) {
   EXPECT_NEAR(with.x(), without.x(), 2.0);
 }
 
-// More blood, darker and redder: at fixed scattering, L* falls and a*/b* rises with B.
-TEST(TissueColour, MoreBloodIsDarkerAndRedder) {
+// More blood, darker: at fixed scattering L* falls with B, and the colour stays a red-yellow one
+// (a* and b* positive), as haemoglobin absorbs blue and green and passes red.
+TEST(TissueColour, MoreBloodIsDarker) {
   TissueOptics t = tissue_optics(Tissue::Muscle);
   double last_l = 100.0;
   for (double b : {0.01, 0.05, 0.1, 0.3, 0.5}) {
