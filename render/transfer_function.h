@@ -1,9 +1,9 @@
 #pragma once
 // Transfer functions (method.md §8): HU → colour and opacity, piecewise linear between points,
 // constant beyond the first and last point. Presets follow 3D Slicer's CT set (presets.xml);
-// "laparoscopic" is pneumo's own (tissue colours computed from published optical properties, gas clear). Opacities are per 1 mm of
-// ray (the opacity unit distance, as in VTK/Slicer); the ray casters correct them for their step:
-// α′ = 1 − (1 − α)^(Δs / 1 mm).
+// "laparoscopic" is pneumo's own (tissue colours computed from published optical properties, gas
+// clear). Opacities are per 1 mm of ray (the opacity unit distance, as in VTK/Slicer); the ray
+// casters correct them for their step: α′ = 1 − (1 − α)^(Δs / 1 mm).
 #include <array>
 #include <string>
 #include <vector>
