@@ -61,7 +61,7 @@ RenderVolume RenderVolume::from_hu(const Geometry& g, std::vector<float>&& hu, c
   return v;
 }
 
-RenderVolume RenderVolume::from_hu(const Geometry& g, std::vector<float>&& hu, std::vector<uint16_t> labels,
+RenderVolume RenderVolume::from_hu(const Geometry& g, std::vector<float>&& hu, std::vector<uint16_t>&& labels,
                                    bool hu_is_int16) {
   const int64_t n = int64_t(labels.size());
   if (n != 0 && n != g.voxel_count())

@@ -46,8 +46,9 @@ struct RenderVolume {
   /// in the pass that rounds them): the 10⁸ values are not read again.
   static RenderVolume from_hu(const Geometry& g, std::vector<float>&& hu, const Volume* labels, bool hu_is_int16);
   /// The same with the labels already 16-bit ids on grid `g` (a run's warp holds them so; empty:
-  /// none), taken as they are: only kExteriorAirLabel, which the views reserve, is refused.
-  static RenderVolume from_hu(const Geometry& g, std::vector<float>&& hu, std::vector<uint16_t> labels,
+  /// none), taken as they are, not copied: only kExteriorAirLabel, which the views reserve, is
+  /// refused, and then neither the HU nor the labels are taken.
+  static RenderVolume from_hu(const Geometry& g, std::vector<float>&& hu, std::vector<uint16_t>&& labels,
                               bool hu_is_int16);
 
   /// Labels air (HU ≤ threshold) connected to the grid's faces as kExteriorAirLabel (6-connected

@@ -100,13 +100,15 @@ TEST(ViewsFromTheWarp, TheWarpsLabelsAreTakenAsTheyAreExceptTheReservedId) {
   std::vector<uint16_t> ids(std::size_t(g.voxel_count()), 0);
   ids[3] = 250;
   ids[7] = 65534;
-  const RenderVolume v = RenderVolume::from_hu(g, std::vector<float>(hu), ids, true);
+  const RenderVolume v = RenderVolume::from_hu(g, std::vector<float>(hu), std::vector<uint16_t>(ids), true);
   EXPECT_EQ(v.labels, ids);
   EXPECT_TRUE(RenderVolume::from_hu(g, std::vector<float>(hu), std::vector<uint16_t>{}, true).labels.empty());
   ids[5] = kExteriorAirLabel;   // reserved for air outside the body
   std::vector<float> kept = hu;
-  EXPECT_THROW(RenderVolume::from_hu(g, std::move(kept), ids, true), InputError);
+  std::vector<uint16_t> kept_ids = ids;
+  EXPECT_THROW(RenderVolume::from_hu(g, std::move(kept), std::move(kept_ids), true), InputError);
   EXPECT_EQ(kept.size(), hu.size());   // refused before the HU were taken
+  EXPECT_EQ(kept_ids, ids);            // and before the labels were
   EXPECT_THROW(RenderVolume::from_hu(g, std::vector<float>(hu), std::vector<uint16_t>(5, 0), true),
                std::invalid_argument);
 }

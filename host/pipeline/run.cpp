@@ -167,17 +167,18 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   if (w.labels) what.labels_path = (out / "deformed_labels.nii.gz").string();
   // The views first, from memory, and the warp's files after them: a user waits for the first view,
   // not for deflating 10⁸ voxels. A render that fails still leaves the warp's files written.
-  // The views take the warp's own HU, rounded as the file holds them (not a float copy of 10⁸
-  // voxels), and give them back for the deformed CT, built after the views; and a copy of its
-  // 16-bit labels, which the deformed label map holds in its own type after the views.
+  // The views take the warp's own HU, rounded as the file holds them, and its 16-bit labels (no
+  // copy of 10⁸ voxels), and give both back for the deformed CT and label map, built after the
+  // views. The render reads them only (render_volumes takes a const RenderVolume&).
   RenderRun rendered;
   RenderVolume views;
   const auto take_back = [&] {
     if (!views.hu.empty()) w.result.ct_hu = std::move(views.hu);
+    if (!views.labels.empty()) w.result.labels = std::move(views.labels);
   };
   try {
     const bool int16 = round_as_written(w.result.ct_hu, deformed_ct_type(w));
-    views = RenderVolume::from_hu(w.output_grid, std::move(w.result.ct_hu), w.result.labels, int16);
+    views = RenderVolume::from_hu(w.output_grid, std::move(w.result.ct_hu), std::move(w.result.labels), int16);
     views.smoothing_mm = scene.render.smoothing_mm;
     rendered = render_volumes(scene, ro, views, what);
   } catch (...) {
@@ -191,7 +192,6 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
     throw;
   }
   take_back();
-  views = RenderVolume();   // its labels' copy, before the deformed volumes are built
   const double seconds_render = seconds_since(t_render);
   log::info("writing the warped CT and labels");
   write_warp(scene, w, o.out_dir);
