@@ -143,15 +143,31 @@ RenderRun render_scene(const Scene& scene, const RenderOptions& opt) {
   return render_volumes(scene, with_before, ct, labels.get(), run);
 }
 
+namespace {
+
+// The render stage once its threads are fitted to the load: each public overload samples the load
+// once, first, so that every pass over the 10⁸ voxels (the float conversion included) runs on the
+// cores other processes leave.
+RenderRun render_fitted(const Scene& scene, const RenderOptions& opt, const RenderVolume& volume, RenderRun run);
+
+}  // namespace
+
 RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Volume& ct, const Volume* labels,
                          RenderRun run) {
+  fit_threads_to_load();
   RenderVolume volume = RenderVolume::from(ct, labels);
   volume.smoothing_mm = scene.render.smoothing_mm;
-  return render_volumes(scene, opt, volume, std::move(run));
+  return render_fitted(scene, opt, volume, std::move(run));
 }
 
 RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const RenderVolume& volume, RenderRun run) {
   fit_threads_to_load();
+  return render_fitted(scene, opt, volume, std::move(run));
+}
+
+namespace {
+
+RenderRun render_fitted(const Scene& scene, const RenderOptions& opt, const RenderVolume& volume, RenderRun run) {
   const auto start = std::chrono::steady_clock::now();
   const ViewSettings& r = scene.render;
   const fs::path out(opt.out_dir);
@@ -329,5 +345,7 @@ RenderRun render_volumes(const Scene& scene, const RenderOptions& opt, const Ren
   write_text_file_atomic((out / "render.json").string(), run.report.dump(2) + "\n");
   return run;
 }
+
+}  // namespace
 
 }  // namespace pneumo
