@@ -77,6 +77,12 @@ void fit_threads_to_load() {
   std::vector<int> samples;
   for (int i = 0; i < 5; ++i) {
     if (i > 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    // Our own threads are not load: OpenMP's workers spin for a while after each loop, and the
+    // sampling thread itself is running (all we can take off when /proc/self/task is unreadable).
+    // Ours are read first: no parallel loop runs here, so a worker can only fall asleep between
+    // the two reads, which makes `others` too small by one at most (and a negative count is 0),
+    // never too large.
+    const int own = std::max(own_runnable_threads(), 1);
     FILE* f = std::fopen("/proc/loadavg", "r");
     if (!f) break;
     char line[256] = {};
@@ -84,11 +90,6 @@ void fit_threads_to_load() {
     std::fclose(f);
     const int n = read ? runnable_tasks(line) : -1;
     if (n < 0) continue;
-    // Our own threads are not load: OpenMP's workers spin for a while after each loop, and the
-    // sampling thread itself is running (all we can take off when /proc/self/task is unreadable).
-    // The two reads are moments apart: a worker that falls asleep between them makes `others`
-    // too small by one at most, and a negative count is 0.
-    const int own = std::max(own_runnable_threads(), 1);
     samples.push_back(std::max(n - own, 0));
   }
   const int threads = cores_left(usable, samples);
