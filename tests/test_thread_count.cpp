@@ -17,7 +17,7 @@ TEST(ThreadCount, CoresLeftAreTheUsableLessTheOtherRunningTasks) {
   EXPECT_EQ(cores_left(2, {1, 1, 1, 1, 1}), 1);     // one busy process beside us
   EXPECT_EQ(cores_left(8, {3, 3, 3, 3, 3}), 5);
   EXPECT_EQ(cores_left(2, {4, 4, 4, 4, 4}), 1);     // never fewer than one
-  EXPECT_EQ(cores_left(4, {-1, -1, 0, 0, 0}), 4);   // never more than usable
+  EXPECT_EQ(cores_left(4, {-1, -1, -1, 0, 0}), 4);  // never more than usable
   // The median: a passing kernel thread or a short burst in one sample does not move it.
   EXPECT_EQ(cores_left(2, {0, 2, 0, 0, 1}), 2);
   EXPECT_EQ(cores_left(4, {2, 0, 2, 2, 8}), 2);

@@ -38,8 +38,7 @@ int cores_left(int usable, std::vector<int> others_samples) {
   if (others_samples.empty()) return usable;
   std::nth_element(others_samples.begin(), others_samples.begin() + others_samples.size() / 2,
                    others_samples.end());
-  const int others = std::max(others_samples[others_samples.size() / 2], 0);
-  return std::clamp(usable - others, 1, usable);
+  return std::clamp(usable - others_samples[others_samples.size() / 2], 1, usable);
 }
 
 int runnable_tasks(const char* line) {
