@@ -2,8 +2,13 @@
 // kernel's count of runnable tasks less this process's own, and reading both from /proc.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <thread>
+#include <vector>
 
 #include "core/error.h"
 #include "core/thread_count.h"
@@ -36,17 +41,41 @@ TEST(ThreadCount, TaskStateIsTheLetterAfterTheName) {
 TEST(ThreadCount, OurOwnSpinningThreadIsNotAnotherProcess) {
   // A thread of ours that spins, as OpenMP's workers do after a loop, is runnable all the while;
   // own_runnable_threads() must see it beside the caller, so that fit_threads_to_load takes it off.
+  // Threads of ours that sleep are not runnable and must not be counted: hw + 8 of them wait on a
+  // condition variable meanwhile (hw the hardware threads). Counting every thread would give
+  // hw + 10 or more; the runnable ones are the caller, the spinner and at most hw − 1 spinning
+  // OpenMP workers left by an earlier test in the same process.
   std::atomic<bool> started{false}, stop{false};
+  std::mutex m;
+  std::condition_variable cv;
+  bool release = false;
+  std::atomic<int> waiting{0};
+  const int hw = std::max(1, int(std::thread::hardware_concurrency())), n_sleepers = hw + 8;
+  std::vector<std::thread> sleepers;
+  for (int i = 0; i < n_sleepers; ++i)
+    sleepers.emplace_back([&] {
+      std::unique_lock<std::mutex> lock(m);
+      ++waiting;
+      cv.wait(lock, [&] { return release; });
+    });
   std::thread spinner([&] {
     started = true;
     while (!stop.load(std::memory_order_relaxed)) {
     }
   });
-  while (!started) std::this_thread::yield();
+  while (!started || waiting < n_sleepers) std::this_thread::yield();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));   // the sleepers settle in their wait
   const int own = own_runnable_threads();
   stop = true;
   spinner.join();
+  {
+    std::lock_guard<std::mutex> lock(m);
+    release = true;
+  }
+  cv.notify_all();
+  for (std::thread& t : sleepers) t.join();
   EXPECT_GE(own, 2);
+  EXPECT_LE(own, hw + 1);
   EXPECT_GE(own_runnable_threads(), 1);   // the caller itself
 }
 
