@@ -29,10 +29,17 @@ void write_frames(const fs::path& dir, int count) {
   }
 }
 
+// A word the test's own shell takes as it is: in single quotes, each ' written '\''.
+std::string shell_quoted(const std::string& s) {
+  std::string q = "'";
+  for (const char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
 // ffprobe's value of one entry (e.g. "stream=nb_read_frames"), as text.
 std::string probe(const fs::path& mp4, const std::string& entry) {
   const auto r = run_shell("ffprobe -v error -count_frames -select_streams v:0 -show_entries " + entry +
-                           " -of default=noprint_wrappers=1:nokey=1 '" + mp4.string() + "'");
+                           " -of default=noprint_wrappers=1:nokey=1 " + shell_quoted(mp4.string()));
   EXPECT_EQ(r.code, 0) << r.err;
   std::string v = r.out;
   while (!v.empty() && (v.back() == '\n' || v.back() == '\r')) v.pop_back();
@@ -61,4 +68,23 @@ TEST(Video, AnMp4PlaysEveryFrameAtTheGivenRate) {
     // 12 frames at fps last 12 / fps seconds; the container may round to its time base.
     EXPECT_NEAR(std::stod(probe(mp4, "format=duration")), 12.0 / fps, 0.5 / fps);
   }
+}
+
+// The folder's name reaches ffmpeg as it is, never through a shell: a quote, a command substitution,
+// a % (image2's pattern character) and a protocol-like prefix are all just characters of the name.
+TEST(Video, AFolderNameIsNeverRunOrReinterpreted) {
+  ASSERT_TRUE(pneumo::ffmpeg_available()) << "ffmpeg is missing: scripts/install_deps.sh installs it";
+  ScratchDir d;
+  const fs::path pwned = fs::path(d.path()) / "PWNED";
+  const std::vector<std::string> names = {"O'Brien", "x'$(touch " + pwned.string() + ")'",
+                                          "100% lap; `touch " + pwned.string() + "`", "http:"};
+  for (const std::string& name : names) {
+    SCOPED_TRACE(name);
+    const fs::path folder = fs::path(d.path()) / name;
+    write_frames(folder / "path", 3);
+    const fs::path mp4 = folder / "path.mp4";
+    ASSERT_TRUE(pneumo::encode_mp4(folder / "path", mp4, 6.0));
+    EXPECT_EQ(probe(mp4, "stream=nb_read_frames"), "3");
+  }
+  EXPECT_FALSE(fs::exists(pwned)) << "a shell ran the folder's name";
 }

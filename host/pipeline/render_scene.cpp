@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "core/atomic_file.h"
+#include "core/child_process.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
@@ -85,22 +86,39 @@ RenderSettings settings_from_scene(const ViewSettings& r, const Geometry& g) {
   return s;
 }
 
-bool ffmpeg_available() { return std::system("command -v ffmpeg >/dev/null 2>&1") == 0; }
+bool ffmpeg_available() { return find_program("ffmpeg").has_value(); }
+
+namespace {
+
+/// A path as ffmpeg's file protocol takes it: "file:" first, so that no part of it is read as another
+/// protocol ("http:…") or as an option ("-…").
+std::string ffmpeg_file(const fs::path& p) { return "file:" + p.string(); }
+
+/// The frames' pattern for ffmpeg's image2 reader, which reads % as a pattern: a % in the folder's
+/// name is written %% (a literal %).
+std::string frame_pattern(const fs::path& frame_dir) {
+  std::string dir;
+  for (const char c : frame_dir.string()) dir += c == '%' ? std::string("%%") : std::string(1, c);
+  return "file:" + dir + "/frame_%04d.png";
+}
+
+}  // namespace
 
 // frames → <dir>.mp4 (H.264); written beside and renamed, so it is atomic too. The input rate is the
-// playback rate: every PNG becomes one frame, none dropped or repeated.
+// playback rate: every PNG becomes one frame, none dropped or repeated. ffmpeg gets an argument
+// vector, never a shell: the folder's name is passed as it is, whatever it holds.
 bool encode_mp4(const fs::path& frame_dir, const fs::path& mp4, double fps) {
   const fs::path tmp = mp4.string() + ".part.mp4";
   char rate[32];
   std::snprintf(rate, sizeof rate, "%.6g", fps);
-  const std::string cmd = std::string("ffmpeg -y -loglevel error -framerate ") + rate + " -i '" +
-                          (frame_dir / "frame_%04d.png").string() +
-                          "' -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -c:v libx264 -pix_fmt yuv420p '" + tmp.string() +
-                          "' </dev/null";
-  if (std::system(cmd.c_str()) != 0) {
+  const int code = run_program({"ffmpeg", "-nostdin", "-y", "-loglevel", "error", "-framerate", rate, "-i",
+                                frame_pattern(frame_dir), "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264",
+                                "-pix_fmt", "yuv420p", ffmpeg_file(tmp)});
+  if (code != 0) {
     std::error_code ec;
     fs::remove(tmp, ec);
-    log::warn("ffmpeg could not encode " + mp4.string() + "; the frames are kept as PNGs");
+    log::warn("ffmpeg could not encode " + mp4.string() + " (exit " + std::to_string(code) +
+              "); the frames are kept as PNGs");
     return false;
   }
   fs::rename(tmp, mp4);
