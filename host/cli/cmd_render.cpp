@@ -5,6 +5,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/output_lock.h"
+#include "core/owned_folder.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/warp_stage.h"
 
@@ -29,6 +30,7 @@ Run add_render(CLI::App& app) {
     // other settings would leave a report of images it did not make. As simulate and warp refuse.
     if (!o->force && std::filesystem::exists(std::filesystem::path(o->out) / "render.json"))
       throw InputError(o->out + ": already holds rendered views (render.json); use --force to replace them");
+    for (const char* own : {"views", "flythrough"}) check_owned_or_absent(std::filesystem::path(o->out) / own);
     RenderOptions opt;
     opt.out_dir = o->out;
     opt.backend = parse_gl_backend(o->backend);

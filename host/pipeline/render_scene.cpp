@@ -14,6 +14,7 @@
 #include "core/child_process.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/owned_folder.h"
 #include "core/progress.h"
 #include "core/thread_count.h"
 #include "image/png.h"
@@ -241,7 +242,7 @@ RenderRun render_fitted(const Scene& scene, const RenderOptions& opt, const Rend
   if (total == 0) throw InputError("the scene's render section has no cameras, ports, paths or exterior views");
 
   Renderer renderer(opt.cpu_reference, opt.backend);
-  fs::create_directories(out / "views");
+  create_owned_folder(out / "views");
   renderer.set_volume(volume);
   nlohmann::json view_report = nlohmann::json::array();
   Progress progress("render", total);
@@ -270,6 +271,7 @@ RenderRun render_fitted(const Scene& scene, const RenderOptions& opt, const Rend
   const bool mp4 = !paths.empty() && ffmpeg_available();
   for (const Path& p : paths) {
     const fs::path dir = out / "flythrough" / p.name;
+    create_owned_folder(out / "flythrough");
     fs::create_directories(dir);
     std::vector<RgbImage> thumbnails;
     for (std::size_t f = 0; f < p.cameras.size(); ++f) {

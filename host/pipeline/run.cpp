@@ -12,6 +12,7 @@
 #include "core/stopwatch.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/owned_folder.h"
 #include "core/units.h"
 #include "evaluate/landmarks.h"
 #include "io/volume_io.h"
@@ -42,12 +43,16 @@ const char* const kRunFiles[] = {"report.html",       "metrics.json",           
 const char* const kRunFolders[] = {"views", "flythrough", "timelapse"};
 
 /// The refusals that need no writing, before the inputs are read: an earlier run's results without
-/// --force (or --resume), an --out that could not be created or written.
+/// --force (or --resume), a folder of the user's where a run keeps its own (views/, …), an --out that
+/// could not be created or written.
 void check_output_folder(const RunOptions& o) {
   const fs::path out(o.out_dir);
   bool earlier = false;
   for (const char* f : kRunFiles) earlier |= fs::exists(out / f);
-  for (const char* f : kRunFolders) earlier |= fs::exists(out / f);
+  for (const char* f : kRunFolders) {
+    check_owned_or_absent(out / f);
+    earlier |= is_owned_folder(out / f);
+  }
   if (earlier && !o.force && !o.resume)
     throw InputError(o.out_dir + ": already holds results of a run; use --force to replace them or --resume to "
                                  "continue an interrupted one");
@@ -64,7 +69,7 @@ void prepare_folder(const RunOptions& o) {
   check_writable_target((out / "report.html").string());
   // report.html goes first, so that an interrupted run never leaves the old one looking current.
   for (const char* f : kRunFiles) fs::remove(out / f, ec);
-  for (const char* f : kRunFolders) fs::remove_all(out / f, ec);
+  for (const char* f : kRunFolders) remove_owned_folder(out / f);
 }
 
 nlohmann::json read_json(const std::string& path) {

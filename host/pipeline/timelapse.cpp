@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "core/log.h"
+#include "core/owned_folder.h"
 #include "core/units.h"
 #include "io/volume.h"
 #include "roles/pad.h"
@@ -29,8 +30,7 @@ Timelapse::Timelapse(const Scene& scene, const Simulation& sim, const std::strin
   }
   r.exterior_views = true;
   preview_.output.write_depth = false;
-  std::error_code ec;
-  fs::remove_all(fs::path(out_dir_) / "timelapse", ec);
+  remove_owned_folder(fs::path(out_dir_) / "timelapse");
 }
 
 void Timelapse::frame(const SolverSnapshot& snapshot) {
@@ -56,6 +56,7 @@ void Timelapse::frame(const SolverSnapshot& snapshot) {
   }
   const PointMap point_map(wm, sim_.roles.role.data());
   RenderOptions ro;
+  create_owned_folder(fs::path(out_dir_) / "timelapse");   // before the frame's scratch folder inside it
   const fs::path scratch = fs::path(out_dir_) / "timelapse" / ".frame";
   ro.out_dir = scratch.string();
   ro.backend = backend_;
