@@ -2,6 +2,7 @@
 // against the matrix-free product of the CPU reference (FemStiffness::MatrixFree), which
 // tests/test_fem.cpp checks against the forces' finite differences.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -147,6 +148,55 @@ TEST(SymmetricBlockCsr, ProductIsTheFullSymmetricMatrixTimesTheVector) {
   double again = 0.0;
   for (int32_t r = 0; r < a.rows(); ++r) again = std::max(again, (y[r] - want[r]).norm());
   EXPECT_LT(again, 1e-12 * max_norm(want));
+}
+
+
+TEST(SymmetricBlockCsr, ProductIsBitIdenticalAtAnyThreadCount) {
+  // A banded pattern like a lattice's (groups of nearby nodes, 60,000 nodes: several chunks of rows,
+  // each with its transposes reaching a band beyond it, and above the size at which the product runs on
+  // every thread): 1, 2 and 3 threads give the same bits, and the product the written-out sum (1e-12 of
+  // the largest |y|: the same terms in another order).
+  constexpr int32_t kNodes = 60000, kBand = 400;
+  std::mt19937 rng(kSeedProduct + 1);
+  std::uniform_int_distribution<int32_t> start(0, kNodes - kBand - 1), offset(0, kBand), size(2, 8);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<int64_t> begin = {0};
+  std::vector<int32_t> nodes;
+  for (int g = 0; g < 40000; ++g) {
+    std::vector<int32_t> members;
+    const int32_t first = start(rng);
+    for (int k = size(rng); k > 0; --k) members.push_back(first + offset(rng));
+    std::sort(members.begin(), members.end());
+    members.erase(std::unique(members.begin(), members.end()), members.end());
+    nodes.insert(nodes.end(), members.begin(), members.end());
+    begin.push_back(int64_t(nodes.size()));
+  }
+  SymmetricBlockCsr a = symmetric_pattern_of_groups(kNodes, begin, nodes);
+  for (Mat3& b : a.block)
+    for (int i = 0; i < 9; ++i) b(i / 3, i % 3) = u(rng);
+  std::vector<Vec3> x(kNodes), want(kNodes, Vec3::Zero());
+  for (Vec3& v : x) v = Vec3(u(rng), u(rng), u(rng));
+  for (int32_t r = 0; r < a.rows(); ++r)
+    for (int64_t k = a.row_start[r]; k < a.row_start[r + 1]; ++k) {
+      const int32_t c = a.col[k];
+      want[r] += a.block[k] * x[c];
+      if (c != r) want[c] += a.block[k].transpose() * x[r];
+    }
+  const int saved = omp_get_max_threads();
+  std::vector<std::vector<Vec3>> y(3);
+  for (int threads = 1; threads <= 3; ++threads) {
+    omp_set_num_threads(threads);
+    a.multiply(x, y[threads - 1]);
+  }
+  omp_set_num_threads(saved);
+  double worst = 0.0;
+  for (int32_t r = 0; r < kNodes; ++r) worst = std::max(worst, (y[0][r] - want[r]).norm());
+  EXPECT_LT(worst, 1e-12 * max_norm(want));
+  for (int t = 1; t < 3; ++t) {
+    int64_t differing = 0;
+    for (int32_t r = 0; r < kNodes; ++r) differing += y[t][r] != y[0][r];
+    EXPECT_EQ(differing, 0) << "rows whose product differs between 1 and " << t + 1 << " threads";
+  }
 }
 
 }  // namespace

@@ -23,11 +23,23 @@ struct SymmetricBlockCsr {
   int64_t rows() const { return int64_t(row_start.size()) - 1; }
   /// The index of block (row, column), column ≥ row, in col/block, or −1 where the pattern has none.
   int64_t find(int32_t row, int32_t column) const;
-  /// y = A x (y resized to rows()), the lower triangle as the upper one's transpose.
+  /// y = A x (y resized to rows()), the lower triangle as the upper one's transpose. Bit for bit the
+  /// same at any thread count: the sums run in an order fixed by the matrix alone.
   void multiply(const std::vector<Vec3>& x, std::vector<Vec3>& y) const;
 
  private:
-  mutable std::vector<std::vector<Vec3>> partial_;   // per thread: the transposed blocks' sums
+  static constexpr int64_t kMaxChunks = 64;
+  /// The rows cut into chunks (first[c] … first[c + 1] − 1), each with the partial sums of its
+  /// transposed blocks over rows first[c] … reach[c] − 1, at partial[offset[c]…]; lowest[k] is the
+  /// first chunk whose partial sums reach into chunk k. Made at the first product after the pattern
+  /// changes.
+  struct ChunkPlan {
+    int64_t rows = -1, entries = -1;
+    std::vector<int64_t> first, reach, offset, lowest;
+    std::vector<Vec3> partial;
+  };
+  void plan_chunks() const;
+  mutable ChunkPlan plan_;
 };
 
 /// The pattern (blocks zero) of all pairs of nodes within a group: group g holds the nodes
