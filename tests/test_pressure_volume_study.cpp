@@ -1,6 +1,8 @@
 // `pneumo validate pressure-volume` (pipeline/pressure_volume_study.h) on the tiny case.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/error.h"
 #include "io_test_support.h"
 #include "pipeline/pressure_volume_study.h"
@@ -48,6 +50,24 @@ TEST(PressureVolumeStudy, CurveComplianceAndFraction) {
   EXPECT_TRUE(linear.all_converged);
   EXPECT_GT(linear.fraction_of_30_at_15, 0.4);
   EXPECT_LT(linear.fraction_of_30_at_15, 0.6);
+}
+
+
+TEST(PressureVolumeStudy, PressuresAScenesCurveWouldRefuseAreRefused) {
+  // Each pressure is checked as a scene's pressure curve is (0 for rest, else 0.1–100 mmHg): a negative
+  // one would "converge" to a negative cavity, a NaN or an absurd one to nonsense. Refused before any
+  // solve, naming the option.
+  ScratchDir d;
+  const Scene scene = load_scene(write_tiny_case(d));
+  for (const std::vector<double>& bad : {std::vector<double>{-5, 5, 15, 30}, {0, 5, 15, 30, NAN},
+                                         {0, 5, 15, 30, 1e6}, {0, 0.05, 5, 15, 30}}) {
+    try {
+      pressure_volume_study(scene, bad);
+      ADD_FAILURE() << "accepted " << bad.front() << " … " << bad.back();
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("--pressures-mmhg"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "pipeline/pressure_volume_study.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/error.h"
 
@@ -17,13 +18,23 @@ double volume_at(const std::vector<PressurePoint>& c, double p) {
 }  // namespace
 
 PressureVolumeStudy pressure_volume_study(const Scene& scene, std::vector<double> pressures_mmhg) {
+  for (const double p : pressures_mmhg)   // before the sort, which needs an order NaN does not have
+    if (!std::isfinite(p)) throw InputError("validate pressure-volume: --pressures-mmhg: every pressure must be a finite number");
   std::sort(pressures_mmhg.begin(), pressures_mmhg.end());
   for (const double p : {5.0, 15.0, 30.0})
     if (!std::binary_search(pressures_mmhg.begin(), pressures_mmhg.end(), p))
       throw InputError("validate pressure-volume: the pressures must include 5, 15 and 30 mmHg");
-  Scene sc = scene;
-  sc.load.pressure_curve_mmhg = pressures_mmhg;
-  sc.load.pressure_mmhg = pressures_mmhg.back();
+  // The curve goes through the scene's own checks (each 0 or 0.1–100 mmHg), as a scene's curve would:
+  // a negative pressure would otherwise "converge" to a negative cavity.
+  nlohmann::json j = scene.echo();
+  j["load"]["pressure_curve_mmhg"] = pressures_mmhg;
+  j["load"]["pressure_mmhg"] = pressures_mmhg.back();
+  Scene sc;
+  try {
+    sc = parse_scene(j, scene.path);
+  } catch (const InputError& e) {
+    throw InputError(std::string("validate pressure-volume: --pressures-mmhg: ") + e.what());
+  }
   const Simulation sim = simulate_scene(sc);
   PressureVolumeStudy s;
   s.curve = sim.pressure_curve;
