@@ -132,6 +132,14 @@ std::vector<Row> rows() {
        {"ct.nii.gz: ", "1 voxels are NaN or infinite", "(5, 6, 4)", "-1000 HU"}, 2, "out", kRolesCommands},
       {"ct_infinite_voxel", [inf](D d) { return with_ct_voxel(d, -inf); },
        {"ct.nii.gz: ", "NaN or infinite", "(5, 6, 4)"}, 2, "out", kRolesCommands},
+      {"ct_all_air_with_labels",
+       [](D d) {
+         Volume ct = tiny_case_ct();
+         for (int64_t n = 0; n < ct.voxel_count(); ++n) ct.data<float>()[n] = -1000.0f;
+         return write_tiny_case(d, tiny_case_scene_json(), ct);
+       },
+       // The labels alone would make a wall and viscera of air, which the gas would lift.
+       {"ct.nii.gz: ", "only 0 of 2560 voxels read as tissue or bone", "no body"}, 2, "out", kRolesCommands},
       {"labels_on_another_grid",
        [](D d) {
          Volume labels = tiny_case_labels();

@@ -35,6 +35,25 @@ void check_finite_ct(const Volume& ct, const std::string& name) {
   throw file_error(name, os.str());
 }
 
+/// A CT that shows no body (all air, or a file that is not the CT in HU) has nothing to inflate: its
+/// labels alone would make a wall of air, which the gas would lift as if it were tissue. Refused when
+/// fewer than one voxel in a thousand reads as tissue or bone (−500 HU and above: fat is about −100,
+/// lung above it −850 to −500, air −1000), naming what was found.
+void check_ct_shows_a_body(const Volume& ct, const std::string& name) {
+  constexpr double kTissueHu = -500.0, kLeastTissueShare = 1e-3;
+  const int64_t n = ct.voxel_count();
+  int64_t tissue = 0;
+  dispatch_voxel_type(ct.type(), const_cast<void*>(ct.raw()), [&](auto* p) {
+#pragma omp parallel for reduction(+ : tissue) schedule(static)
+    for (int64_t v = 0; v < n; ++v) tissue += static_cast<double>(p[v]) >= kTissueHu;
+  });
+  if (double(tissue) >= kLeastTissueShare * double(n)) return;
+  std::ostringstream os;
+  os << "only " << tissue << " of " << n << " voxels read as tissue or bone (" << kTissueHu
+     << " HU and above): this CT shows no body (all air?); give the CT in Hounsfield units";
+  throw file_error(name, os.str());
+}
+
 Volume padded_ct_float(const Volume& ct, const PadVoxels& pad) {
   Volume out(padded_geometry(ct.geometry(), pad), VoxelType::Float32);
   dispatch_voxel_type(ct.type(), const_cast<void*>(ct.raw()), [&](auto* src) {
@@ -96,6 +115,7 @@ RoleVolume assign_roles(const RoleRules& rules, const Volume& ct, const Volume* 
   require_labels_if_needed(rules, labels != nullptr, names);
   ct.geometry().validate(names.ct);
   check_finite_ct(ct, names.ct);
+  check_ct_shows_a_body(ct, names.ct);
   if (labels) {
     check_labels_on_ct_grid(ct.geometry(), labels->geometry(), names.ct, names.labels);
     check_label_values(*labels, names.labels);
