@@ -140,6 +140,14 @@ std::vector<Row> rows() {
        },
        // The labels alone would make a wall and viscera of air, which the gas would lift.
        {"ct.nii.gz: ", "only 0 of 2560 voxels read as tissue or bone", "no body"}, 2, "out", kRolesCommands},
+      {"port_aimed_at_a_missing_label",
+       [](D d) {
+         json s = tiny_case_scene_json();
+         s["render"]["ports"] = {{{"name", "liver"}, {"skin_point_mm", {0, 0, 140}}, {"target_label", 99}}};
+         return write_tiny_case(d, s);
+       },
+       // Refused before the solve: a run leaves nothing behind it.
+       {"labels.nii.gz: ", "port 'liver': target_label 99 labels no voxel"}, 2, "out", {"run"}},
       {"labels_on_another_grid",
        [](D d) {
          Volume labels = tiny_case_labels();

@@ -87,6 +87,24 @@ RenderSettings settings_from_scene(const ViewSettings& r, const Geometry& g) {
   return s;
 }
 
+void check_port_targets(const Scene& scene, const RoleVolume& roles) {
+  std::vector<char> present;   // by id, filled at the first port that aims at a label
+  for (const Port& p : scene.render.ports) {
+    if (!p.target_label) continue;
+    const int id = *p.target_label;
+    if (scene.inputs.labels.empty())
+      throw InputError("port '" + p.name + "': target_label " + std::to_string(id) + " needs a label map (inputs.labels)");
+    if (present.empty()) {
+      present.assign(65536, 0);
+      for (const uint16_t l : roles.label) present[l] = 1;
+    }
+    if (id < 0 || id > 65535 || !present[std::size_t(id)])
+      throw file_error(scene.inputs.labels, "port '" + p.name + "': target_label " + std::to_string(id) +
+                                                " labels no voxel of this label map; aim it at an id the map holds "
+                                                "(pneumo info lists them) or at target_mm");
+  }
+}
+
 bool ffmpeg_available() { return find_program("ffmpeg").has_value(); }
 
 namespace {

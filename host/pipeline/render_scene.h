@@ -23,6 +23,7 @@
 #include "render/poses.h"
 #include "render/render_settings.h"
 #include "render/render_volume.h"
+#include "roles/roles.h"
 #include "warp/warp.h"
 #include "scene/scene.h"
 
@@ -69,6 +70,10 @@ RenderSettings settings_from_scene(const ViewSettings& r, const Geometry& g);
 /// packs HU and gradient into one 16-bit texture as it does there. Half a HU is below any transfer
 /// function's resolution. No intermediate Volume: the result is copied once.
 RenderVolume render_volume_of(const WarpResult& w, const Geometry& g);
+
+/// InputError naming the port when a port aims at a label (target_label) that the scene's label map
+/// lacks, or when there is no label map: checked on the roles' labels before the solve, not after it.
+void check_port_targets(const Scene& scene, const RoleVolume& roles);
 
 /// Whether ffmpeg is on PATH, and frames frame_0001.png … in `frame_dir` → `mp4` (H.264 at `fps`
 /// frames/s, written beside and renamed; false with a warning when ffmpeg fails).

@@ -92,6 +92,7 @@ RunSummary run_pipeline(const Scene& scene, const RunOptions& o) {
   log::info("stage 1/4: roles, mesh and solver");
   Simulation sim = prepare_simulation(scene, /*keep_inputs=*/true);   // the warp reads them too
   check_cavity_label_free(scene, sim.roles);
+  check_port_targets(scene, sim.roles);   // a port the labels cannot aim is refused now, not after the solve
   scene_label_names(scene);   // a bad names file is refused now, not after the solve
   SolveHooks hooks;
   if (o.resume && fs::exists(checkpoint)) {
