@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <set>
 #include <string>
 
 #include "cli_test_support.h"
@@ -86,6 +87,30 @@ TEST(FullDisk, AWarpThatFailsAfterItsFirstImagesRemovesThemAndCanBeRunAgain) {
   EXPECT_FALSE(fs::exists(d.file("out/deformed_ct.nii.gz")));
   EXPECT_FALSE(nlohmann::json::parse(slurp(d.file("out/metrics.json"))).contains("warp")) << "still marked as warped";
   EXPECT_EQ(run_pneumo("-q warp " + scene + " --out " + d.file("out")).code, 0);
+}
+
+
+// Whichever file a full disk stops, the run failed on valid input: exit 1 and one line naming the
+// file, never exit 2 (bad input), whose advice would send the user to the wrong place. Swept over
+// per-file limits just below each file `simulate` writes, so that each size class fails in turn
+// (the meshes, the deformation, the plots and the JSON files).
+TEST(FullDisk, EveryFileSimulateCannotWriteExitsOneNamingIt) {
+  ScratchDir d;
+  const std::string scene = write_tiny_case(d, tiny_case_scene_json(), tiny_case_ct());
+  ASSERT_EQ(run_pneumo("-q simulate " + scene + " --out " + d.file("probe")).code, 0);
+  std::set<int> limits_kib;
+  for (const auto& e : fs::directory_iterator(d.file("probe")))
+    if (e.is_regular_file() && e.file_size() > 1024) limits_kib.insert(int((e.file_size() - 1) / 1024));
+  ASSERT_GE(limits_kib.size(), 2u);
+  for (const int kib : limits_kib) {
+    SCOPED_TRACE(std::to_string(kib) + " KiB");
+    const std::string out = d.file("out_" + std::to_string(kib));
+    const CliResult r = run_pneumo_with_file_limit(kib, "-q simulate " + scene + " --out " + out);
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(out), std::string::npos) << "the file is not named: " << r.err;
+    EXPECT_EQ(r.err.find(".tmp"), std::string::npos) << "a temporary name reached the user: " << r.err;
+  }
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <zlib.h>
 
+#include <cerrno>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -133,7 +134,7 @@ void write_vtu(const Mesh& m, const std::vector<Vec3>& x_in, const std::string& 
     for (const Array& a : cells) out.write(a.bytes.data(), std::streamsize(a.bytes.size()));
     out << "\n  </AppendedData>\n</VTKFile>\n";
     out.flush();
-    if (!out) throw file_error(path, "writing failed (disk full?)");
+    if (!out) throw std::runtime_error(path + ": writing failed: " + std::strerror(errno) + " (disk full?)");
   }
   file.commit();
 }
