@@ -1,9 +1,7 @@
 #include "serve/http_server.h"
 
-#include <httplib.h>
-// glibc's <resolv.h>, which cpp-httplib includes, defines the macro _res, a parameter name in Eigen's
-// templates: it must not reach the headers below.
-#undef _res
+#include "serve/bounded_http_server.h"   // cpp-httplib, its _res macro undefined before Eigen comes
+
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -155,7 +153,7 @@ struct Server::Impl {
   ServeOptions opt;
   std::unique_ptr<PlanningSession> session;   // built and used on the worker's thread only
   std::unique_ptr<SerialWorker> worker;
-  httplib::Server http;
+  BoundedHttpServer http;
   RateLimit rate;
   std::mutex plan_mutex;
   pid_t plan_pid = -1;
@@ -213,15 +211,17 @@ int Server::bind() {
   if (s.opt.host != "127.0.0.1" && s.opt.host != "localhost" && s.opt.host != "::1")
     log::warn("serve: listening on " + s.opt.host +
               ": anyone who can reach this address can see the case and drive the solver; there is no login");
-  if (s.opt.port == 0) {
-    const int port = s.http.bind_to_any_port(s.opt.host);
+  int port = s.opt.port;
+  if (port == 0) {
+    port = s.http.bind_to_any_port(s.opt.host);
     if (port < 0) throw std::runtime_error("serve: cannot bind " + s.opt.host);
-    return port;
-  }
-  if (!s.http.bind_to_port(s.opt.host, s.opt.port))
-    throw std::runtime_error("serve: cannot bind " + s.opt.host + ":" + std::to_string(s.opt.port) +
+  } else if (!s.http.bind_to_port(s.opt.host, port)) {
+    throw std::runtime_error("serve: cannot bind " + s.opt.host + ":" + std::to_string(port) +
                              " (in use? choose another with --port)");
-  return s.opt.port;
+  }
+  // A burst of views (many tabs, a script) must queue for accept(), not be dropped by the kernel.
+  if (!s.http.raise_listen_backlog()) log::warn("serve: cannot raise the listen backlog; bursts of requests may wait");
+  return port;
 }
 
 void Server::listen() { impl_->http.listen_after_bind(); }
