@@ -2,12 +2,18 @@
 // real HTTP client on a real socket: the page and its files, the laparoscope's and the body's views
 // (PNG), a click on the skin placing a port where the skin is, a re-inflation from the last
 // equilibrium with latest-wins, bad input answered 400 with the reason, the body and rate limits,
-// a burst of views all answered while the status still answers, and a server that stops promptly in
-// the middle of a solve.
+// a burst of views all answered and clients that drip their requests dropped while the status still
+// answers, and a server that stops promptly in the middle of a solve.
 #include <gtest/gtest.h>
 
 #include <httplib.h>
 #undef _res   // glibc's resolv.h macro, a parameter name in Eigen (host/serve/http_server.cpp says why)
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -80,6 +86,30 @@ class ServeApi : public ::testing::Test {
 };
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// A blocking TCP connection to 127.0.0.1:port; -1 when refused.
+int connect_local(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(uint16_t(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (fd >= 0 && ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) return fd;
+  if (fd >= 0) ::close(fd);
+  return -1;
+}
+
+/// Whether the server has closed `fd` (end of stream or reset; what it answered before is read
+/// and dropped), without waiting.
+bool closed_by_server(int fd) {
+  pollfd p{fd, POLLIN, 0};
+  while (::poll(&p, 1, 0) > 0) {
+    char buf[512];
+    const ssize_t n = ::recv(fd, buf, sizeof buf, MSG_DONTWAIT);
+    if (n <= 0) return true;
+  }
+  return false;
+}
 
 /// /api/status on a connection of its own: its HTTP status (-1: no answer) and how long it took.
 std::pair<int, double> timed_status(int port) {
@@ -382,4 +412,59 @@ TEST_F(ServeApi, ABurstOfViewsIsAnsweredWhileTheStatusAnswers) {
   EXPECT_GT(ok, 0);
   std::printf("%d views: %d answered 200, %d 503, the last after %.2f s; the slowest status %.3f s\n", kBurst, ok,
               busy, *std::max_element(answered_after.begin(), answered_after.end()), slowest_status);
+}
+
+// Slow clients: 13 connections, one more than the 12 request threads cpp-httplib's pool had, each
+// sending its request's head one byte a second, as a stalled or hostile client does. Each is closed
+// once its request has taken the read limit (5 s), and the status, polled meanwhile on connections
+// of its own, answers every time within 1 s.
+TEST_F(ServeApi, ClientsDrippingTheirRequestsAreDroppedWhileTheStatusAnswers) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  const std::string head = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: " + std::string(64, 'a') + "\r\n\r\n";
+  constexpr int kSlow = 13;
+  std::vector<int> slow;
+  std::vector<Clock::time_point> connected;
+  for (int k = 0; k < kSlow; ++k) {
+    slow.push_back(connect_local(port_));
+    connected.push_back(Clock::now());
+  }
+  ASSERT_EQ(std::count(slow.begin(), slow.end(), -1), 0);
+  const auto t0 = Clock::now();
+  std::vector<double> dropped_after(kSlow, -1.0);
+  std::atomic<bool> dripping{true};
+  std::thread drip([&] {
+    for (std::size_t byte = 0; byte < head.size() && seconds_since(t0) < 12.0; ++byte) {
+      for (int k = 0; k < kSlow; ++k) {
+        if (dropped_after[k] >= 0) continue;
+        if (closed_by_server(slow[k]) || ::send(slow[k], &head[byte], 1, MSG_NOSIGNAL) != 1)
+          dropped_after[k] = seconds_since(connected[k]);
+      }
+      if (std::count(dropped_after.begin(), dropped_after.end(), -1.0) == 0) break;
+      std::this_thread::sleep_for(std::chrono::seconds(1));
+    }
+    dripping = false;
+  });
+  double slowest_status = 0.0;
+  int statuses = 0;
+  while (dripping && seconds_since(t0) < 15.0) {
+    const auto [code, seconds] = timed_status(port_);
+    EXPECT_EQ(code, 200) << "the status after " << seconds_since(t0) << " s";
+    EXPECT_LT(seconds, 1.0) << "the status after " << seconds_since(t0) << " s";
+    slowest_status = std::max(slowest_status, seconds);
+    ++statuses;
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+  }
+  drip.join();
+  for (int fd : slow) ::close(fd);
+  for (int k = 0; k < kSlow; ++k) {
+    if (dropped_after[k] < 0) {
+      ADD_FAILURE() << "slow client " << k << " was never dropped";
+      continue;
+    }
+    EXPECT_GE(dropped_after[k], 4.0) << "slow client " << k << " was dropped before its read limit";
+    EXPECT_LT(dropped_after[k], 8.0) << "slow client " << k;
+  }
+  std::printf("%d statuses, the slowest %.3f s; slow clients dropped after %.1f to %.1f s\n", statuses,
+              slowest_status, *std::min_element(dropped_after.begin(), dropped_after.end()),
+              *std::max_element(dropped_after.begin(), dropped_after.end()));
 }

@@ -295,10 +295,9 @@ void Server::Impl::start_plan(const nlohmann::json& body) {
 
 void Server::Impl::routes() {
   rate.per_second = opt.requests_per_second;
-  // More request threads than views may wait for the worker (SerialWorker::kMaxShortTasks), so the
-  // status and the controls always find one; idle keep-alive connections let go of theirs soon.
-  http.new_task_queue = [] { return new httplib::ThreadPool(12); };
-  http.set_keep_alive_timeout(1);
+  // Each connection has a thread of its own (BoundedHttpServer), far more than views may wait for the
+  // worker (SerialWorker::kMaxShortTasks), and each one's hold on it is bounded in time, so the
+  // status and the controls always find one.
   http.set_payload_max_length(kMaxBodyBytes);
   const bool loopback = opt.host == "127.0.0.1" || opt.host == "localhost" || opt.host == "::1";
   http.set_pre_routing_handler([this, loopback](const httplib::Request& q, httplib::Response& res) {
