@@ -3,7 +3,8 @@
 // (PNG), a click on the skin placing a port where the skin is, a re-inflation from the last
 // equilibrium with latest-wins, bad input answered 400 with the reason, the body and rate limits,
 // a burst of views all answered and clients that drip their requests dropped while the status still
-// answers, and a server that stops promptly in the middle of a solve.
+// answers, JSON with an unknown or duplicate key or trailing bytes refused, the scene read as the
+// CLI reads it, and a server that stops promptly in the middle of a solve.
 #include <gtest/gtest.h>
 
 #include <httplib.h>
@@ -23,8 +24,10 @@
 #include <thread>
 
 #include "cli_test_support.h"
+#include "core/error.h"
 #include "core/progress.h"
 #include "phantom/phantom.h"
+#include "scene/scene.h"
 #include "serve/http_server.h"
 #include "stb_image_support.h"
 
@@ -40,7 +43,8 @@ std::string write_case(const ScratchDir& dir) {
   write_phantom_case(make_phantom(PhantomSize::Small), PhantomSize::Small, dir.path().string());
   nlohmann::json j = nlohmann::json::parse(testing_support::slurp(dir.file("scene.json")));
   j["preset"] = "preview";
-  std::ofstream(dir.file("serve_scene.json")) << j.dump(2);
+  std::ofstream(dir.file("serve_scene.json")) << "// The small phantom at preview: a scene written by hand may hold comments.\n"
+                                              << j.dump(2);
   return dir.file("serve_scene.json");
 }
 
@@ -467,4 +471,73 @@ TEST_F(ServeApi, ClientsDrippingTheirRequestsAreDroppedWhileTheStatusAnswers) {
   std::printf("%d statuses, the slowest %.3f s; slow clients dropped after %.1f to %.1f s\n", statuses,
               slowest_status, *std::min_element(dropped_after.begin(), dropped_after.end()),
               *std::max_element(dropped_after.begin(), dropped_after.end()));
+}
+
+// Nothing the user did not ask for runs: a key of a request's JSON that its endpoint does not read
+// (a misspelling: "pressure_mmHg"), a key given twice, or bytes after the JSON value are refused
+// with 400 naming the problem, on every endpoint that reads JSON, and nothing starts.
+TEST_F(ServeApi, UnknownAndDuplicateKeysAndTrailingBytesAreRefused) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  const uint64_t generation = status()["generation_latest"];
+  const auto refused = [&](const std::string& path, const std::string& body, const std::string& says) {
+    const auto r = body.empty() ? client_->Get(path.c_str()) : client_->Post(path.c_str(), body, "application/json");
+    ASSERT_TRUE(r) << path;
+    EXPECT_EQ(r->status, 400) << path << " " << body;
+    EXPECT_NE(r->body.find(says), std::string::npos) << path << " " << body << " → " << r->body;
+  };
+  const std::string unknown = "is an unknown key", twice = "is given twice", trailing = "expected end of input";
+  refused("/api/inflate", R"({"pressure_mmHg": 20})", R"(\"pressure_mmHg\" is an unknown key; did you mean \"pressure_mmhg\"?)");
+  refused("/api/inflate", R"({"pressure_mmhg": 20, "pressure_mmhg": 8})", "pressure_mmhg " + twice);
+  refused("/api/inflate", R"({"pressure_mmhg": 20} 8)", trailing);
+  refused("/api/pick", R"({"x": 100, "y": 75, "sid": "left"})", R"(did you mean \"side\"?)");
+  refused("/api/pick", R"({"x": 100, "y": 75, "x": 3})", "x " + twice);
+  refused("/api/pick", R"({"x": 100, "y": 75}})", trailing);
+  refused("/api/ports", R"({"target_label": 5, "grid": 20})", R"(did you mean \"grid_mm\"?)");
+  refused("/api/ports", R"({"target_label": 5, "region": {"side": "anterior", "w": 200, "h": 150, "x0": 0, "y0": 0, "x1": 9, "y1": 9, "x2": 3}})",
+          R"(region: \"x2\" is an unknown key)");
+  refused("/api/ports", R"({"target_label": 5, "top": 3, "top": 4})", "top " + twice);
+  refused("/api/ports", R"({"target_label": 5}{})", trailing);
+  const std::string port = R"({"skin_point_mm": [0, 110, -20], "target_label": 5, "insertion_mm": 45})";
+  refused("/api/plan", R"({"ports": [)" + port + R"(], "prots": []})", R"(\"prots\" is an unknown key; did you mean \"ports\"?)");
+  refused("/api/plan", R"({"ports": [{"skin_point_mm": [0, 110, -20], "target_label": 5, "insertion": 45}]})", unknown);
+  refused("/api/plan", R"({"ports": [], "ports": [)" + port + "]}", "ports " + twice);
+  refused("/api/plan", R"({"ports": [)" + port + "]} x", trailing);
+  const auto view = [](const std::string& json) {
+    return "/api/scope.png?w=160&h=120&port=" + httplib::detail::encode_query_param(json);
+  };
+  refused(view(R"({"skin_point_mm": [0, 110, -20], "target_label": 5, "fov": 70})"), "", unknown);
+  refused(view(R"({"skin_point_mm": [0, 110, -20], "target_label": 5, "target_label": 6})"), "", "target_label " + twice);
+  refused(view(R"({"skin_point_mm": [0, 110, -20], "target_label": 5} ])"), "", trailing);
+  const nlohmann::json s = status();
+  EXPECT_EQ(s["generation_latest"].get<uint64_t>(), generation) << "nothing refused started a solve";
+  EXPECT_EQ(s["plan"]["state"], "none") << "nothing refused started a plan";
+}
+
+// serve reads its scene with the CLI's reader: comments, as scenes written by hand hold (the
+// fixture's scene starts with one), and a key given twice refused with the message `pneumo run` gives.
+TEST(ServeScene, ReadAsTheCliReadsIt) {
+  Progress::set_enabled(false);
+  ScratchDir dir;
+  const std::string commented = write_case(dir);
+  ASSERT_EQ(testing_support::slurp(commented).rfind("//", 0), 0u);
+  std::string text = testing_support::slurp(commented);
+  text.insert(text.find('{') + 1, "\n  \"preset\": \"balanced\",");
+  const std::string twice = dir.file("twice.json");
+  std::ofstream(twice) << text;
+  std::string cli_message;
+  try {
+    load_scene(twice);
+  } catch (const InputError& e) {
+    cli_message = e.what();
+  }
+  EXPECT_NE(cli_message.find("preset is given twice"), std::string::npos) << cli_message;
+  serve::ServeOptions o;
+  o.scene_path = twice;
+  o.port = 0;
+  try {
+    serve::Server refused(o);
+    ADD_FAILURE() << "a scene with a key given twice was served";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), cli_message);
+  }
 }

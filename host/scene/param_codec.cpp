@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "scene/param_table.h"
+#include "scene/scene_json.h"
 
 namespace pneumo::scene_detail {
 namespace {
@@ -366,3 +367,17 @@ void fail_missing(const ParamInfo& p, const At& at) {
 }
 
 }  // namespace pneumo::scene_detail
+
+namespace pneumo {
+
+std::string nearest_known_name(const std::string& typed, const std::vector<std::string>& known) {
+  std::string best;
+  std::size_t best_d = scene_detail::kFar;
+  for (const std::string& k : known) {
+    const std::size_t d = scene_detail::closeness(typed, k);
+    if (d < best_d) best_d = d, best = k;
+  }
+  return best;
+}
+
+}  // namespace pneumo

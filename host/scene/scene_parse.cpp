@@ -1,5 +1,6 @@
 // Scene files → Scene: reading the text (JSON with comments, duplicate keys refused, errors with
-// line and column), then the parameter table, then the cross-key rules.
+// line and column), then the parameter table, then the cross-key rules. `pneumo serve` reads its
+// scene and its requests' JSON with the same reader (parse_json_text).
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
@@ -12,6 +13,7 @@
 #include "core/error.h"
 #include "scene/param_table.h"
 #include "scene/scene.h"
+#include "scene/scene_json.h"
 #include "scene/scene_presets.h"
 
 namespace pneumo {
@@ -131,7 +133,24 @@ void check_nesting(const std::string& text, const std::string& path) {
   }
 }
 
-json read_json_file(const std::string& path) {
+}  // namespace
+
+json parse_json_text(const std::string& text, const std::string& origin) {
+  check_nesting(text, origin);
+  try {
+    // Comments (// and /* */) are allowed: scenes are written by hand.
+    return json::parse(text, DuplicateKeyCheck(origin), /*allow_exceptions=*/true, /*ignore_comments=*/true);
+  } catch (const json::parse_error& e) {
+    // e.byte is one past the offending character.
+    throw file_error(origin, "invalid JSON at " + line_column(text, e.byte > 0 ? e.byte - 1 : 0) + ": " +
+                                 parse_problem(e));
+  } catch (const json::out_of_range& e) {
+    // A number too large for a double (1e999): nlohmann reports it as out_of_range, with no position.
+    throw file_error(origin, "invalid JSON: " + parse_problem(e));
+  }
+}
+
+json read_scene_json(const std::string& path) {
   if (std::filesystem::is_directory(path)) throw file_error(path, "is a folder, not a scene file");
   std::error_code size_error;
   const std::uintmax_t bytes = std::filesystem::file_size(path, size_error);
@@ -142,20 +161,10 @@ json read_json_file(const std::string& path) {
   if (!in) throw file_error(path, std::string("cannot open the scene file (") + std::strerror(errno) + ")");
   std::ostringstream buffer;
   buffer << in.rdbuf();
-  const std::string text = buffer.str();
-  check_nesting(text, path);
-  try {
-    // Comments (// and /* */) are allowed: scenes are written by hand.
-    return json::parse(text, DuplicateKeyCheck(path), /*allow_exceptions=*/true, /*ignore_comments=*/true);
-  } catch (const json::parse_error& e) {
-    // e.byte is one past the offending character.
-    throw file_error(path, "invalid JSON at " + line_column(text, e.byte > 0 ? e.byte - 1 : 0) + ": " +
-                               parse_problem(e));
-  } catch (const json::out_of_range& e) {
-    // A number too large for a double (1e999): nlohmann reports it as out_of_range, with no position.
-    throw file_error(path, "invalid JSON: " + parse_problem(e));
-  }
+  return parse_json_text(buffer.str(), path);
 }
+
+namespace {
 
 /// The material model a scene's JSON names, else the default's (a misspelt one is left to the table, which
 /// names the allowed values).
@@ -215,7 +224,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& origin_path) {
   return s;
 }
 
-Scene load_scene(const std::string& path) { return parse_scene(read_json_file(path), path); }
+Scene load_scene(const std::string& path) { return parse_scene(read_scene_json(path), path); }
 
 Scene default_scene() { return Scene{}; }
 

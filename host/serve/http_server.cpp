@@ -21,8 +21,10 @@
 #include "core/mime_type.h"
 #include "render/gl_context.h"
 #include "scene/scene.h"
+#include "scene/scene_json.h"
 #include "serve/embedded_page.h"
 #include "serve/planning_session.h"
+#include "serve/request_json.h"
 #include "serve/serial_worker.h"
 
 extern char** environ;
@@ -32,16 +34,6 @@ namespace pneumo::serve {
 namespace fs = std::filesystem;
 
 namespace {
-
-nlohmann::json read_scene_json(const std::string& path) {
-  std::ifstream is(path);
-  if (!is) throw InputError(path + ": cannot read the scene");
-  try {
-    return nlohmann::json::parse(is);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(path + ": not valid JSON (" + e.what() + ")");
-  }
-}
 
 /// A whole number in [lo, hi] (image sizes, label ids): checked on the double, before any cast.
 int whole(double d, const char* key, double lo, double hi) {
@@ -73,13 +65,9 @@ Vec3 vec3_of(const nlohmann::json& j, const std::string& what) {
 ScopeRequest scope_request(const httplib::Request& q) {
   nlohmann::json port = {{"name", "view"}};
   if (q.has_param("port")) {
-    // The whole port as the scene writes it (lens, up, near plane too), as the page keeps it.
-    try {
-      port = nlohmann::json::parse(q.get_param_value("port"));
-    } catch (const nlohmann::json::exception&) {
-      throw InputError("port: not valid JSON");
-    }
-    if (!port.is_object()) throw InputError("port: a JSON object expected");
+    // The whole port as the scene writes it (lens, up, near plane too), as the page keeps it; its
+    // keys are the scene port's, which read_port checks.
+    port = read_json_object(q.get_param_value("port"), "port");
     port["name"] = "view";
   } else {
     const Vec3 skin(number(q, "sx", NAN), number(q, "sy", NAN), number(q, "sz", NAN));
@@ -105,15 +93,10 @@ ScopeRequest scope_request(const httplib::Request& q) {
   return s;
 }
 
-/// A request's JSON body (objects only).
-nlohmann::json body_json(const httplib::Request& q) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(q.body.empty() ? "{}" : q.body);
-  } catch (const nlohmann::json::exception&) {
-    throw InputError("the body is not valid JSON");
-  }
-  if (!j.is_object()) throw InputError("the body must be a JSON object");
+/// A POST's JSON body: an object whose keys are all among `known` (what the endpoint reads).
+nlohmann::json body_json(const httplib::Request& q, const std::vector<std::string>& known) {
+  nlohmann::json j = read_json_object(q.body, "the body");
+  check_known_keys(j, "the body", known);
   return j;
 }
 
@@ -363,7 +346,7 @@ void Server::Impl::routes() {
     answer_json(res, session->case_info());
   });
   http.Post("/api/inflate", [this](const httplib::Request& q, httplib::Response& res) {
-    const nlohmann::json b = body_json(q);
+    const nlohmann::json b = body_json(q, {"pressure_mmhg", "wall_young_kpa", "preset"});
     InflateRequest r;
     if (b.contains("pressure_mmhg")) r.pressure_mmhg = b["pressure_mmhg"].get<double>();
     if (b.contains("wall_young_kpa")) r.wall_young_kpa = b["wall_young_kpa"].get<double>();
@@ -394,7 +377,7 @@ void Server::Impl::routes() {
     res.set_content(on_worker([&] { return session->exterior_png(side, w, h, ports, heat); }), "image/png");
   });
   http.Post("/api/pick", [this](const httplib::Request& q, httplib::Response& res) {
-    const nlohmann::json b = body_json(q);
+    const nlohmann::json b = body_json(q, {"x", "y", "side", "w", "h"});
     const double x = b.value("x", -1.0), y = b.value("y", -1.0);
     const std::string side = b.value("side", std::string("anterior"));
     const int w = whole(b.value("w", 480.0), "w", 16, 1920), h = whole(b.value("h", 360.0), "h", 16, 1080);
@@ -402,7 +385,7 @@ void Server::Impl::routes() {
     answer_json(res, {{"skin_point_mm", p ? nlohmann::json{p->x(), p->y(), p->z()} : nlohmann::json()}});
   });
   http.Post("/api/ports", [this](const httplib::Request& q, httplib::Response& res) {
-    const nlohmann::json b = body_json(q);
+    const nlohmann::json b = body_json(q, {"target_label", "ports", "grid_mm", "top", "region"});
     if (!b.contains("target_label") || !b["target_label"].is_number())
       throw InputError("ports: \"target_label\" (an organ's label id) is required");
     const int target = whole(b["target_label"].get<double>(), "target_label", 1, 65535);
@@ -418,6 +401,7 @@ void Server::Impl::routes() {
     if (b.contains("region") && !b["region"].is_null()) {
       const nlohmann::json& g = b["region"];
       if (!g.is_object()) throw InputError("region: an object {side, w, h, x0, y0, x1, y1} expected");
+      check_known_keys(g, "region", {"side", "w", "h", "x0", "y0", "x1", "y1"});
       RankRegion r;
       r.side = g.value("side", std::string("anterior"));
       r.width = whole(g.value("w", 480.0), "region.w", 16, 1920);
@@ -434,7 +418,7 @@ void Server::Impl::routes() {
     res.set_content(on_worker([&] { return session->slices_png(); }), "image/png");
   });
   http.Post("/api/plan", [this](const httplib::Request& q, httplib::Response& res) {
-    start_plan(body_json(q));
+    start_plan(body_json(q, {"ports"}));
     std::lock_guard<std::mutex> lock(plan_mutex);
     answer_json(res, plan_status, 202);
   });

@@ -26,6 +26,8 @@
 // Safe by default: it binds 127.0.0.1 unless told otherwise (and warns when not), and then answers
 // only Hosts naming this machine (403) and POSTs declared JSON (415), so other web pages cannot drive
 // it; no file path or scene text is taken from a client (the plan's ports are checked as a scene's);
+// JSON (bodies, the `port` parameter) is read as scene files are, and a key given twice, bytes after
+// the value, or a key the endpoint does not read is refused (400, naming it) rather than ignored;
 // request bodies up to kMaxBodyBytes (413); at most kMaxRequestsPerSecond requests a second (429);
 // views queue on one worker (503 when SerialWorker::kMaxShortTasks wait); SIGINT and SIGTERM stop it
 // cleanly, a plan's run with it.
