@@ -1,11 +1,13 @@
 // Writes the fuzzers' seed corpora: small valid volumes of every voxel type in every format pneumo
 // reads (so the fuzzers start from files that pass every header check and mutate from there), and
 // the scenes shipped in scenes/; and the hostile headers of tests/hostile_headers.h, so mutation
-// starts at the size checks too. Usage: make_seeds SOURCE_DIR OUT_DIR; OUT_DIR/{nifti,metaimage,nrrd,scene}.
+// starts at the size checks too; and request bodies and ports as `pneumo serve`'s page sends them.
+// Usage: make_seeds SOURCE_DIR OUT_DIR; OUT_DIR/{nifti,metaimage,nrrd,scene,request_json}.
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 
@@ -22,7 +24,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path source = argv[1], out = argv[2];
-  for (const char* sub : {"nifti", "metaimage", "nrrd", "scene"}) fs::create_directories(out / sub);
+  for (const char* sub : {"nifti", "metaimage", "nrrd", "scene", "request_json"}) fs::create_directories(out / sub);
   std::mt19937 rng(20261124);
   const VoxelType types[] = {VoxelType::Int8,   VoxelType::UInt8,  VoxelType::Int16,   VoxelType::UInt16,
                              VoxelType::Int32,  VoxelType::UInt32, VoxelType::Float32, VoxelType::Float64};
@@ -54,5 +56,12 @@ int main(int argc, char** argv) {
       fs::copy_file(e.path(), out / "scene" / e.path().filename(), fs::copy_options::overwrite_existing);
   // Every key at its default (unset ones as null): each section and key is in the corpus once.
   std::ofstream(out / "scene" / "default_echo.json") << default_scene().echo().dump(2) << "\n";
+  const char* requests[] = {
+      R"({"pressure_mmhg": 12, "wall_young_kpa": 40, "preset": "preview"})",
+      R"({"skin_point_mm": [0, 110, -20], "target_label": 5, "insertion_mm": 45, "oblique_deg": 30, "roll_deg": 0})",
+      R"({"skin_point_mm": [0, 110, -20], "target_mm": [0, 0, 0], "fov_deg": 70} // a comment)",
+  };
+  for (std::size_t i = 0; i < std::size(requests); ++i)
+    std::ofstream(out / "request_json" / ("r" + std::to_string(i) + ".json")) << requests[i];
   return 0;
 }
