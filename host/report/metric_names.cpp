@@ -29,7 +29,7 @@ constexpr Entry kEntries[] = {
     {"mean_viscera_displacement_mm", "Mean viscera displacement", "mm", "Result", 1},
     {"mean_viscera_anterior_displacement_mm", "Mean anterior displacement of the viscera", "mm", "Result", 1},
     {"anterior_viscera_posterior_motion_mm", "Posterior motion of the anterior viscera", "mm", "Result", 1},
-    {"viscera_volume_change_ml", "Change of the viscera's tissue volume", "ml", "Result", 0},
+    {"viscera_volume_change_ml", "Change of the viscera's tissue volume", "ml", "Result", 1},
     {"max_fixed_displacement_mm", "Largest displacement of a fixed node", "mm", "Result", 1},
     {"deformed_body_outside_grid_mm", "Deformed body beyond the output grid", "mm", "Result", 1},
     {"inverted_tetrahedra", "Inverted tetrahedra", "", "Result", 1},
