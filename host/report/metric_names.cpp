@@ -120,6 +120,12 @@ MetricName metric_name(const std::string& key) {
   return m;
 }
 
+std::vector<std::string> listed_metric_keys() {
+  std::vector<std::string> keys;
+  for (const Entry& e : kEntries) keys.push_back(e.key);
+  return keys;
+}
+
 const std::vector<std::string>& metric_groups() {
   static const std::vector<std::string> g{"Result", "Solver", "Model", "Warp", "Other"};
   return g;

@@ -17,6 +17,10 @@ struct MetricName {
 /// The name of `key` (a top-level key, or "parent.child" for a nested one).
 MetricName metric_name(const std::string& key);
 
+/// Every key with an entry of its own (not named from its suffix), in the order the table lists
+/// them, "parent.child" for nested ones: a test builds a metrics.json of them all and reads each back.
+std::vector<std::string> listed_metric_keys();
+
 /// The report's groups, in the order shown.
 const std::vector<std::string>& metric_groups();
 
