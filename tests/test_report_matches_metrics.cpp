@@ -401,6 +401,7 @@ TEST(ReportMatchesMetrics, EveryFigureOfEveryKnownKeyIsItsMetric) {
   // is the stored value to the 4 digits printed (÷ 100 in %), in the unit the key's suffix promises.
   json m = json::object();
   int i = 0;
+  // Entries of an array's columns (pressure_curve.*) land in an object here; the array set below replaces it.
   for (const std::string& key : listed_metric_keys()) m[pointer_of(key)] = distinctive_value(key, i++);
   m["some_new_length_mm"] = 2.718;
   m["some_new_share_fraction"] = 0.0123;

@@ -78,6 +78,9 @@ constexpr Entry kEntries[] = {
     {"pneumo_version", "pneumo version", "", "Other", 1},
     {"scene", "Scene file", "", "Other", 1},
     {"pipeline_complete", "Pipeline complete", "", "Other", 1},
+    // Columns of an array's table whose own key's name would say something else: the curve's cavity
+    // is the mesh's estimate at each pressure, not the warped CT's voxels that cavity_volume_ml counts.
+    {"pressure_curve.cavity_volume_ml", "Insufflated cavity (mesh)", "ml", "Other", 1},
 };
 // clang-format on
 
@@ -118,6 +121,13 @@ MetricName metric_name(const std::string& key) {
   if (!stem.empty() && stem[0] >= 'a' && stem[0] <= 'z') stem[0] = char(stem[0] - 'a' + 'A');
   m.name = stem;
   return m;
+}
+
+MetricName column_name(const std::string& array_key, const std::string& column) {
+  const std::string nested = array_key + "." + column;
+  for (const Entry& e : kEntries)
+    if (nested == e.key) return {e.name, e.unit, e.group, e.scale};
+  return metric_name(column);
 }
 
 std::vector<std::string> listed_metric_keys() {

@@ -17,6 +17,10 @@ struct MetricName {
 /// The name of `key` (a top-level key, or "parent.child" for a nested one).
 MetricName metric_name(const std::string& key);
 
+/// The name of `column` in the table of the array `array_key` (an array of objects, such as
+/// pressure_curve): its entry as "array_key.column" where it has one, else the column's own.
+MetricName column_name(const std::string& array_key, const std::string& column);
+
 /// Every key with an entry of its own (not named from its suffix), in the order the table lists
 /// them, "parent.child" for nested ones: a test builds a metrics.json of them all and reads each back.
 std::vector<std::string> listed_metric_keys();

@@ -88,18 +88,19 @@ void leaves(const json& obj, const std::string& prefix, std::vector<Row>& out, s
 }
 
 /// An array of objects as a table, the first object's keys as columns, named with units.
-void array_table(const json& arr, std::ostringstream& o) {
+void array_table(const std::string& key, const json& arr, std::ostringstream& o) {
   o << "<table><tr>";
   for (auto it = arr.front().begin(); it != arr.front().end(); ++it) {
-    const MetricName n = metric_name(it.key());
+    const MetricName n = column_name(key, it.key());
     o << "<th>" << escape_markup(n.name) << (n.unit.empty() ? "" : " (" + escape_markup(n.unit) + ")") << "</th>";
   }
   o << "</tr>\n";
   for (const auto& row : arr) {
     o << "<tr>";
-    for (auto it = arr.front().begin(); it != arr.front().end(); ++it)
-      o << "<td>" << (row.contains(it.key()) ? escape_markup(cell(row.at(it.key()), metric_name(it.key()).scale)) : "")
-        << "</td>";
+    for (auto it = arr.front().begin(); it != arr.front().end(); ++it) {
+      const double scale = column_name(key, it.key()).scale;
+      o << "<td>" << (row.contains(it.key()) ? escape_markup(cell(row.at(it.key()), scale)) : "") << "</td>";
+    }
     o << "</tr>\n";
   }
   o << "</table>\n";
@@ -223,7 +224,7 @@ void metrics_tables(const json& m, std::ostringstream& o) {
   for (const Row& t : tables) {
     const MetricName n = metric_name(t.key);
     o << "<h3>" << escape_markup(n.name) << "</h3>\n";
-    array_table(*t.value, o);
+    array_table(t.key, *t.value, o);
   }
 }
 
