@@ -17,9 +17,19 @@
 
 #include "io/gzip_members.h"
 #include "io/volume_io.h"
+#include "io_test_support.h"
 
 namespace pneumo {
 namespace {
+
+/// A file name of this process and test alone, in a folder removed when the process ends: ctest runs
+/// tests side by side, each in its own process, and two that wrote one fixed name in the temporary
+/// folder read each other's bytes.
+std::string own_temp_path(const std::string& name) {
+  static const testing_support::ScratchDir dir;
+  const ::testing::TestInfo* t = ::testing::UnitTest::GetInstance()->current_test_info();
+  return dir.file(std::string(t ? t->name() : "") + "_" + name);
+}
 
 struct Inflated {
   std::vector<unsigned char> bytes;
@@ -53,7 +63,7 @@ Inflated inflate_members(const std::vector<unsigned char>& gz) {
 }
 
 std::vector<unsigned char> written(const std::vector<ByteSpan>& parts, int threads) {
-  const std::string path = ::testing::TempDir() + "/gzip_members_" + std::to_string(threads) + ".gz";
+  const std::string path = own_temp_path("gzip_members_" + std::to_string(threads) + ".gz");
   std::FILE* f = std::fopen(path.c_str(), "wb");
   EXPECT_NE(f, nullptr);
   const int saved = omp_get_max_threads();
@@ -65,6 +75,7 @@ std::vector<unsigned char> written(const std::vector<ByteSpan>& parts, int threa
   std::vector<unsigned char> gz;
   for (int c; (c = std::fgetc(r)) != EOF;) gz.push_back(static_cast<unsigned char>(c));
   std::fclose(r);
+  std::remove(path.c_str());
   return gz;
 }
 
@@ -103,7 +114,7 @@ TEST(GzipMembers, AnEmptyPartIsAnEmptyMember) {
 
 namespace {
 std::string write_file(const std::string& name, const std::vector<unsigned char>& bytes) {
-  const std::string path = ::testing::TempDir() + "/" + name;
+  const std::string path = own_temp_path(name);
   std::FILE* f = std::fopen(path.c_str(), "wb");
   EXPECT_NE(f, nullptr);
   std::fwrite(bytes.data(), 1, bytes.size(), f);
@@ -146,14 +157,14 @@ TEST(GzipMembers, ReadBackOnEveryCoreExactlyAndOnlyTheirOwnLayout) {
   bent[bent.size() / 2] ^= 0x40;
   EXPECT_FALSE(inflate_gzip_members(write_file("members_bent.gz", bent), head.size(), payload, back.data()));
   // zlib's own gzip (one member, no lengths in its header): declined, for the stream reader.
-  const std::string plain = ::testing::TempDir() + "/zlib_plain.gz";
+  const std::string plain = own_temp_path("zlib_plain.gz");
   gzFile z = gzopen(plain.c_str(), "wb1");
   ASSERT_NE(z, nullptr);
   gzwrite(z, head.data(), unsigned(head.size()));
   gzwrite(z, voxels.data(), unsigned(payload));
   gzclose(z);
   EXPECT_FALSE(inflate_gzip_members(plain, head.size(), payload, back.data()));
-  EXPECT_FALSE(inflate_gzip_members(::testing::TempDir() + "/no_such_file.gz", 0, 1, back.data()));
+  EXPECT_FALSE(inflate_gzip_members(own_temp_path("no_such_file.gz"), 0, 1, back.data()));
 }
 
 TEST(GzipMembers, AFullDiskIsAnError) {
@@ -185,7 +196,7 @@ TEST(GzipMembers, ANiftiPneumoWritesIsReadOnEveryCore) {
   g.dims = {37, 29, 11};
   Volume v(g, VoxelType::Int16);
   for (int64_t n = 0; n < v.voxel_count(); ++n) v.data<int16_t>()[n] = int16_t(n % 3001 - 1000);
-  const std::string path = ::testing::TempDir() + "/members_volume.nii.gz";
+  const std::string path = own_temp_path("members_volume.nii.gz");
   write_volume(v, path);
   std::vector<int16_t> back(std::size_t(v.voxel_count()), 0);
   ASSERT_TRUE(inflate_gzip_members(path, 352, v.byte_count(), back.data()));
