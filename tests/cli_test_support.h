@@ -50,4 +50,10 @@ inline CliResult run_shell(const std::string& command) {
 /// `pneumo ARGS`, as run_shell runs it.
 inline CliResult run_pneumo(const std::string& args) { return run_shell(std::string(PNEUMO_CLI_PATH) + " " + args); }
 
+/// `pneumo ARGS` killed after `seconds` (exit 124; 137 where it ignores SIGTERM): for input a faulty
+/// reader would wait on forever (a FIFO), so that such a fault fails its test instead of hanging the suite.
+inline CliResult run_pneumo_within(int seconds, const std::string& args) {
+  return run_shell("timeout -k 5 " + std::to_string(seconds) + " " + PNEUMO_CLI_PATH + " " + args);
+}
+
 }  // namespace pneumo::testing_support

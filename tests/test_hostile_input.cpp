@@ -189,7 +189,7 @@ std::vector<Row> rows() {
        {"scene.json: ", "invalid JSON at line 1"}},
       {"scene_missing", [](D d) { return d.file("no_scene.json"); }, {"no_scene.json: "}},
       {"ct_missing", [](D d) { return with_scene(d, "/inputs/ct", "nowhere.nii.gz"); },
-       {"nowhere.nii.gz: ", "cannot open: No such file"}},
+       {"nowhere.nii.gz: ", "does not exist"}},
       {"cavity_label_taken", [](D d) { return with_scene(d, "/output/cavity_label", 2); },
        {"labels.nii.gz: ", "already uses label 2", "output.cavity_label"}, 2, "out", {"run", "warp"}},
       {"out_under_a_file",

@@ -566,7 +566,7 @@ TEST(SceneFiles, MissingFileDuplicateKeysAndComments) {
     load_scene("/nonexistent/scene.json");
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_CONTAINS(e.what(), "/nonexistent/scene.json: cannot open the scene file");
+    EXPECT_CONTAINS(e.what(), "/nonexistent/scene.json: the scene file does not exist");
   }
   const std::string dup = write_temp("dup.json", R"({"render": {"cameras": [{"name": "a", "name": "b"}]}})");
   try {
@@ -607,7 +607,7 @@ TEST(SceneFiles, DeepNestingAndHugeFilesAreRefusedBeforeParsing) {
     load_scene(big);
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_CONTAINS(e.what(), "big.json: is " + std::to_string((17u << 20) + 12) + " bytes; a scene file is at most 16777216");
+    EXPECT_CONTAINS(e.what(), "big.json: the scene file is " + std::to_string((17u << 20) + 12) + " bytes; at most 16777216 are read");
   }
 }
 

@@ -7,6 +7,7 @@
 #include "cli/commands.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/input_file.h"
 #include "core/output_lock.h"
 #include "pipeline/warp_stage.h"
 
@@ -15,8 +16,9 @@ namespace pneumo::cli {
 namespace {
 /// Whether metrics.json already holds a warp's keys (a warp that wrote no images ran too).
 bool warp_metrics_present(const std::string& path) {
-  std::ifstream is(path);
-  const auto j = nlohmann::json::parse(is, nullptr, false);
+  if (probe_file(path).kind == FileKind::Missing) return false;
+  const auto j = nlohmann::json::parse(read_input_file(path, kMaxMetricsBytes, "the metrics", "metrics.json is a few kB"),
+                                      nullptr, false);
   return !j.is_discarded() && j.is_object() && j.contains("warp");
 }
 }  // namespace

@@ -66,7 +66,8 @@ struct MappedFile {
   const unsigned char* data = nullptr;
   std::size_t size = 0;
   explicit MappedFile(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY);
+    // O_NONBLOCK: a path swapped for a FIFO since it was checked is refused by fstat, not waited on.
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) return;
     struct stat st {};
     if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {

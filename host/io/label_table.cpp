@@ -3,15 +3,18 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/input_file.h"
 
 namespace pneumo {
 
 namespace {
+
+// A label table names at most 65,536 labels: a few MB at the very most.
+constexpr uint64_t kMaxLabelTableBytes = 16u << 20;
 
 /// The comma-separated fields of one CSV line (no quoting: label names hold none of ",\"").
 std::vector<std::string> fields(const std::string& line) {
@@ -30,8 +33,7 @@ std::vector<std::string> fields(const std::string& line) {
 }  // namespace
 
 std::map<int, std::string> read_label_names(const std::string& path) {
-  std::ifstream is(path);
-  if (!is) throw file_error(path, "cannot open the label names");
+  std::istringstream is(read_input_file(path, kMaxLabelTableBytes, "the label names", "16 MB; a label table is a few kB"));
   std::string line;
   int line_no = 0;
   int id_col = -1, name_col = -1;

@@ -14,7 +14,6 @@
 // ITK's direction matrix. AnatomicalOrientation is informational: MetaIO writes, per axis, the first
 // letter of its from-to pair (MET_OrientationTypeName in metaTypes.h), i.e. the side the axis comes
 // from, so an identity (LPS) direction is written "RAI".
-#include <sys/stat.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -37,6 +36,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/input_file.h"
 #include "io/volume_io.h"
 
 namespace fs = std::filesystem;
@@ -81,22 +81,15 @@ std::vector<std::string> split_words(const std::string& s) {
   return words;
 }
 
-/// Size of a regular file; refuses folders, FIFOs and devices (reading one could block forever).
+/// Size of a regular file (core/input_file.h): folders, FIFOs and devices are refused before they
+/// are opened (reading one could block forever, or never end).
 uint64_t regular_file_size(const std::string& reported_path, const std::string& path, const std::string& what) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) {
-    if (errno == ENOENT) throw file_error(reported_path, what + " does not exist");
-    throw file_error(reported_path, "cannot open " + what + ": " + std::strerror(errno));
-  }
-  if (S_ISDIR(st.st_mode)) throw file_error(reported_path, what + " is a folder, not a file");
-  if (!S_ISREG(st.st_mode)) throw file_error(reported_path, what + " is not a regular file");
-  return static_cast<uint64_t>(st.st_size);
+  return require_regular_file(path, what, reported_path);
 }
 
+/// The file opened as the regular-file check opens it: what is read is what was checked.
 FilePtr open_for_reading(const std::string& reported_path, const std::string& path, const std::string& what) {
-  FilePtr f(std::fopen(path.c_str(), "rb"));
-  if (!f) throw file_error(reported_path, "cannot open " + what + ": " + std::strerror(errno));
-  return f;
+  return FilePtr(InputFile(path, what, reported_path).release_to_stdio());
 }
 
 void seek_to(const std::string& reported_path, std::FILE* f, uint64_t offset) {

@@ -5,8 +5,6 @@
 #include <nifti2_io.h>
 #include <zlib.h>
 
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +16,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/input_file.h"
 #include "core/progress.h"
 #include "io/gzip_members.h"
 #include "io/volume_io.h"
@@ -45,9 +44,12 @@ struct GzCloser {
 };
 using GzPtr = std::unique_ptr<gzFile_s, GzCloser>;
 
+/// zlib reads the descriptor the regular-file check opened (core/input_file.h): never a FIFO's.
 GzPtr open_for_reading(const std::string& path) {
-  GzPtr f(gzopen(path.c_str(), "rb"));
+  InputFile file(path);
+  GzPtr f(gzdopen(file.fd(), "rb"));
   if (!f) throw file_error(path, "cannot open: " + std::string(std::strerror(errno)));
+  file.release();   // gzclose_r closes it
   return f;
 }
 
@@ -95,13 +97,6 @@ struct NimDeleter {
 using NimPtr = std::unique_ptr<nifti_image, NimDeleter>;
 
 bool is_gz(const std::string& path) { return volume_format_from_path(path) == VolumeFormat::NiftiGz; }
-
-uint64_t file_size(const std::string& path) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) throw file_error(path, "cannot open: " + std::string(std::strerror(errno)));
-  if (S_ISDIR(st.st_mode)) throw file_error(path, "is a folder, not a file");
-  return static_cast<uint64_t>(st.st_size);
-}
 
 VoxelType voxel_type_from_nifti(const std::string& path, int datatype) {
   switch (datatype) {
@@ -261,7 +256,7 @@ Volume apply_scaling(Volume v, double slope, double inter) {
 
 Volume read_nifti(const std::string& path) {
   quiet_niftilib();
-  const uint64_t on_disk = file_size(path);
+  const uint64_t on_disk = require_regular_file(path);
   bool swapped = false;
   const nifti_1_header raw = read_checked_header(path, &swapped);
   check_spacing_and_transform(path, raw, swapped);

@@ -7,13 +7,15 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <cctype>
+#include <cstdio>
 #include <sstream>
 #include <memory>
-#include <sys/stat.h>
+#include <vector>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/input_file.h"
 #include "io/volume_io.h"
 
 namespace pneumo {
@@ -115,17 +117,99 @@ Geometry geometry_of(const std::string& path, const Nrrd& n) {
   return g;
 }
 
-/// Bytes after the attached header: NRRD's header ends at its first empty line.
-uint64_t attached_data_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  uint64_t header = 0;
-  while (std::getline(in, line)) {
-    header += line.size() + 1;
-    if (line.empty() || line == "\r") break;
+/// What pneumo reads of a NRRD before teem does: the header's length and the data files it names.
+struct NrrdHeaderScan {
+  uint64_t header_bytes = 0;             // through the empty line that ends an attached header
+  uint64_t file_bytes = 0;
+  std::vector<std::string> data_files;   // a detached header's, resolved against its folder
+};
+
+// A detached header names its data files in one of three ways (teem's "data file" field): one name;
+// "LIST", then one name a line to the end of the header; or a printf format with %d and min, max,
+// step. A header of thousands of slices takes well under this many bytes and files.
+constexpr uint64_t kMaxNrrdHeaderBytes = 16u << 20;
+constexpr int64_t kMaxNrrdDataFiles = 1 << 16;
+
+std::string trimmed(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r"), e = s.find_last_not_of(" \t\r");
+  return b == std::string::npos ? "" : s.substr(b, e - b + 1);
+}
+
+/// The names "fmt min max step" gives, as teem's sprintf(fmt, n) makes them. The format must hold
+/// exactly one %d (with an optional zero-padded width): it comes from the file, and anything else
+/// in a printf format would read arguments that are not there.
+std::vector<std::string> formatted_data_files(const std::string& path, const std::vector<std::string>& words) {
+  const std::string& format = words[0];
+  const std::size_t at = format.find('%');
+  std::size_t d = at + 1;
+  while (d < format.size() && std::isdigit(static_cast<unsigned char>(format[d]))) ++d;
+  if (d >= format.size() || format[d] != 'd' || d - at > 4 || format.find('%', d) != std::string::npos)
+    throw file_error(path, "its data file format \"" + format + "\" is not one name with one %d in it");
+  int64_t first = 0, last = 0, step = 0;
+  try {
+    first = std::stoll(words[1]), last = std::stoll(words[2]), step = std::stoll(words[3]);
+  } catch (const std::exception&) {
+    throw file_error(path, "its data file numbers \"" + words[1] + " " + words[2] + " " + words[3] + "\" are not integers");
   }
-  const uint64_t total = uint64_t(std::filesystem::file_size(path));
-  return total > header ? total - header : 0;
+  if (step == 0 || (last - first) / step < 0 || (last - first) / step >= kMaxNrrdDataFiles)
+    throw file_error(path, "its data file numbers " + words[1] + " to " + words[2] + " by " + words[3] +
+                               " do not name between 1 and " + std::to_string(kMaxNrrdDataFiles) + " files");
+  std::vector<std::string> names;
+  for (int64_t n = first; step > 0 ? n <= last : n >= last; n += step) {
+    char name[4096];
+    std::snprintf(name, sizeof name, format.c_str(), int(n));
+    names.push_back(name);
+  }
+  return names;
+}
+
+/// Reads the header as far as its empty line, through the regular-file check, and resolves the data
+/// files it names. teem opens a detached header's data files by name while it parses the header
+/// (even when told to skip the data), so they are checked here first: a FIFO would block it forever.
+NrrdHeaderScan scan_nrrd_header(const std::string& path) {
+  InputFile file(path);
+  NrrdHeaderScan scan;
+  scan.file_bytes = file.size();
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> in(file.release_to_stdio(), &std::fclose);
+  std::vector<std::string> lines;
+  std::string line;
+  for (int c; scan.header_bytes < kMaxNrrdHeaderBytes && (c = std::getc(in.get())) != EOF;) {
+    ++scan.header_bytes;
+    if (c != '\n') {
+      line += char(c);
+      continue;
+    }
+    if (trimmed(line).empty()) break;   // the end of the header: attached data follows
+    lines.push_back(line);
+    line.clear();
+  }
+  if (!line.empty()) lines.push_back(line);
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  const auto resolved = [&](const std::string& name) {
+    return std::filesystem::path(name).is_absolute() ? name : (folder / name).string();
+  };
+  for (std::size_t l = 0; l < lines.size(); ++l) {
+    const std::size_t colon = lines[l].find(':');
+    if (lines[l][0] == '#' || colon == std::string::npos || lines[l].compare(colon, 2, ":=") == 0) continue;
+    const std::string field = trimmed(lines[l].substr(0, colon));
+    if (field != "data file" && field != "datafile") continue;
+    const std::string value = trimmed(lines[l].substr(colon + 1));
+    std::vector<std::string> words;
+    std::istringstream split(value);
+    for (std::string w; split >> w;) words.push_back(w);
+    std::vector<std::string> names;
+    if (!words.empty() && words[0] == "LIST") {
+      for (std::size_t k = l + 1; k < lines.size(); ++k)
+        if (!trimmed(lines[k]).empty()) names.push_back(trimmed(lines[k]));
+      l = lines.size();
+    } else if (words.size() >= 4 && words[0].find('%') != std::string::npos) {
+      names = formatted_data_files(path, words);
+    } else {
+      names.push_back(value);
+    }
+    for (const std::string& n : names) scan.data_files.push_back(resolved(n));
+  }
+  return scan;
 }
 
 /// The most voxel bytes `available` bytes of `encoding` can hold, so a header whose sizes promise
@@ -140,16 +224,11 @@ uint64_t most_voxel_bytes(const std::string& encoding, uint64_t available, std::
   return UINT64_MAX;
 }
 
-void require_file(const std::string& path) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) throw file_error(path, "does not exist or cannot be read");
-  if (S_ISDIR(st.st_mode)) throw file_error(path, "is a folder, not a file");
-}
-
 }  // namespace
 
 Volume read_nrrd(const std::string& path) {
-  require_file(path);
+  const NrrdHeaderScan scan = scan_nrrd_header(path);
+  for (const std::string& data : scan.data_files) require_regular_file(data, "its data file " + data, path);
   // The header first (teem reads no voxels with skipData): what it promises is checked before any
   // allocation, as every reader here does.
   Geometry g;
@@ -166,17 +245,14 @@ Volume read_nrrd(const std::string& path) {
     // What the file (or the detached header's data files) holds, against what the sizes promise.
     uint64_t available = 0;
     if (io->dataFNArr->len == 0) {
-      available = attached_data_bytes(path);
+      available = scan.file_bytes > scan.header_bytes ? scan.file_bytes - scan.header_bytes : 0;
     } else {
       const std::filesystem::path folder = std::filesystem::path(path).parent_path();
       for (unsigned int f = 0; f < io->dataFNArr->len; ++f) {
         const std::filesystem::path data = std::filesystem::path(io->dataFN[f]).is_absolute()
                                                ? std::filesystem::path(io->dataFN[f])
                                                : folder / io->dataFN[f];
-        std::error_code ec;
-        const auto bytes = std::filesystem::file_size(data, ec);
-        if (ec) throw file_error(path, "its data file " + data.string() + " cannot be read");
-        available += uint64_t(bytes);
+        available += require_regular_file(data.string(), "its data file " + data.string(), path);
       }
     }
     const std::string encoding = io->encoding ? io->encoding->name : "raw";

@@ -3,11 +3,14 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <cstdio>
 #include <fstream>
+#include <memory>
 #include <stdexcept>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/input_file.h"
 
 namespace pneumo {
 
@@ -84,11 +87,14 @@ void write_deformation(const std::string& path, const Mesh& mesh, const Deformat
 }
 
 Deformation read_deformation(const std::string& path, const Mesh& mesh) {
-  std::ifstream is(path, std::ios::binary);
-  if (!is) throw file_error(path, "cannot open the deformation (run pneumo simulate with this --out first)");
+  if (probe_file(path).kind == FileKind::Missing)
+    throw file_error(path, "cannot open the deformation (run pneumo simulate with this --out first)");
+  // A regular file (core/input_file.h): a FIFO or a device under the name is refused, not read.
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(InputFile(path, "the deformation").release_to_stdio(),
+                                                      &std::fclose);
+  std::FILE* is = file.get();
   Header h{};
-  is.read(reinterpret_cast<char*>(&h), sizeof h);
-  if (is.gcount() != std::streamsize(sizeof h) || std::memcmp(h.magic, kMagic, sizeof kMagic) != 0)
+  if (std::fread(&h, 1, sizeof h, is) != sizeof h || std::memcmp(h.magic, kMagic, sizeof kMagic) != 0)
     throw file_error(path, "not a pneumo deformation file");
   if (h.version != kVersion || h.header_bytes != kHeaderBytes)
     throw file_error(path, "deformation file version " + std::to_string(h.version) + ", this pneumo reads version " +
@@ -104,9 +110,10 @@ Deformation read_deformation(const std::string& path, const Mesh& mesh) {
   d.pressure_pa = h.pressure_pa;
   d.converged = (h.flags & 1u) != 0;
   d.displacement_m.resize(std::size_t(h.nodes));
-  for (Vec3& v : d.displacement_m) is.read(reinterpret_cast<char*>(v.data()), 3 * sizeof(double));
-  if (!is) throw file_error(path, "truncated: fewer displacements than its " + std::to_string(h.nodes) + " nodes");
-  if (is.peek() != std::char_traits<char>::eof()) throw file_error(path, "trailing bytes after the displacements");
+  bool whole = true;
+  for (Vec3& v : d.displacement_m) whole = whole && std::fread(v.data(), sizeof(double), 3, is) == 3;
+  if (!whole) throw file_error(path, "truncated: fewer displacements than its " + std::to_string(h.nodes) + " nodes");
+  if (std::fgetc(is) != EOF) throw file_error(path, "trailing bytes after the displacements");
   if (payload_checksum(d.displacement_m) != h.checksum) throw file_error(path, "corrupt: the checksum does not match");
   for (const Vec3& v : d.displacement_m)
     if (!v.allFinite()) throw file_error(path, "holds a non-finite displacement");

@@ -11,6 +11,7 @@
 #include "core/atomic_file.h"
 #include "core/stopwatch.h"
 #include "core/error.h"
+#include "core/input_file.h"
 #include "core/log.h"
 #include "core/owned_folder.h"
 #include "core/units.h"
@@ -73,8 +74,8 @@ void prepare_folder(const RunOptions& o) {
 }
 
 nlohmann::json read_json(const std::string& path) {
-  std::ifstream is(path);
-  const auto j = nlohmann::json::parse(is, nullptr, false);
+  const auto j = nlohmann::json::parse(read_input_file(path, kMaxMetricsBytes, "the metrics", "metrics.json is a few kB"),
+                                      nullptr, false);
   if (j.is_discarded()) throw file_error(path, "not valid JSON");
   return j;
 }

@@ -9,6 +9,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/input_file.h"
 #include "core/log.h"
 #include "core/units.h"
 #include "core/thread_count.h"
@@ -44,12 +45,11 @@ std::string in_dir(const std::string& dir, const char* name) { return (fs::path(
 
 nlohmann::json read_metrics(const std::string& dir) {
   const std::string path = in_dir(dir, "metrics.json");
-  std::ifstream is(path);
-  if (!is)
+  if (probe_file(path).kind == FileKind::Missing)
     throw file_error(path, "missing: " + dir + " holds no finished simulation; run pneumo simulate SCENE --out " +
                                dir + " first");
   try {
-    return nlohmann::json::parse(is);
+    return nlohmann::json::parse(read_input_file(path, kMaxMetricsBytes, "the metrics", "metrics.json is a few kB"));
   } catch (const nlohmann::json::exception& e) {
     throw file_error(path, std::string("not valid JSON (") + e.what() + ")");
   }

@@ -98,6 +98,10 @@ std::vector<LabelTableEntry> deformed_label_entries(const Scene& scene, const Wa
 /// The deformed label map in the input's type when it holds the cavity label, else uint16.
 Volume deformed_label_volume(const WarpedCase& w, int cavity_label);
 
+/// The most of a metrics.json pneumo reads back (it writes a few kB): a folder's file swapped for
+/// something endless is refused, not read (core/input_file.h).
+constexpr uint64_t kMaxMetricsBytes = 64u << 20;
+
 /// The keys the warp adds to metrics.json (see write_warp).
 nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w);
 

@@ -2,15 +2,14 @@
 // line and column), then the parameter table, then the cross-key rules. `pneumo serve` reads its
 // scene and its requests' JSON with the same reader (parse_json_text).
 #include <algorithm>
-#include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <vector>
 
 #include "core/error.h"
+#include "core/input_file.h"
 #include "scene/param_table.h"
 #include "scene/scene.h"
 #include "scene/scene_json.h"
@@ -151,17 +150,9 @@ json parse_json_text(const std::string& text, const std::string& origin) {
 }
 
 json read_scene_json(const std::string& path) {
-  if (std::filesystem::is_directory(path)) throw file_error(path, "is a folder, not a scene file");
-  std::error_code size_error;
-  const std::uintmax_t bytes = std::filesystem::file_size(path, size_error);
-  if (!size_error && bytes > kMaxSceneBytes)
-    throw file_error(path, "is " + std::to_string(bytes) + " bytes; a scene file is at most " +
-                               std::to_string(kMaxSceneBytes) + " (16 MB; scenes are a few kB)");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw file_error(path, std::string("cannot open the scene file (") + std::strerror(errno) + ")");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return parse_json_text(buffer.str(), path);
+  // The cap holds however the file is given: a FIFO or a device (a link to /dev/zero) has no size
+  // to compare, and is refused before it is read (core/input_file.h).
+  return parse_json_text(read_input_file(path, kMaxSceneBytes, "the scene file", "16 MB; scenes are a few kB"), path);
 }
 
 namespace {
