@@ -3,6 +3,8 @@
 // same world points; what is not one CT volume is refused with a message that says what is wrong.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -108,6 +110,51 @@ TEST(DicomSeries, WhatIsNotOneCtVolumeIsRefusedSayingWhy) {
   const CliResult r = run_pneumo("info " + d.file("notes"));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("holds no DICOM file"), std::string::npos) << r.err;
+}
+
+TEST(DicomSeries, AFifoOrADanglingLinkAmongTheSlicesIsRefusedNamingIt) {
+  // GDCM's own listing stopped at the first entry it could not stat (a dangling link: the slices
+  // listed before it were read as the CT, exit 0) and its scan opened a FIFO (waiting for ever).
+  // The names sort among the slices' (hexadecimal names), so neither is first or last.
+  ScratchDir d;
+  write_volume(tiny_case_ct(), d.file("ct.nii.gz"));
+  const struct {
+    const char* entry;
+    const char* says;
+  } cases[] = {{"8fifo.dcm", "8fifo.dcm is a FIFO (named pipe), not a regular file: move it out of the folder"},
+               {"8dangling.dcm", "8dangling.dcm is a symbolic link to"}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.entry);
+    const std::string dir = d.file(std::string("series_") + c.entry);
+    write_series(d.file("ct.nii.gz"), dir);
+    const std::string entry = dir + "/" + c.entry;
+    if (std::string(c.entry) == "8fifo.dcm") ASSERT_EQ(::mkfifo(entry.c_str(), 0600), 0);
+    else std::filesystem::create_symlink(dir + "/gone.dcm", entry);
+    const CliResult r = run_pneumo_within(60, "info " + dir);
+    EXPECT_EQ(r.code, 2) << "124 or 137: it waited on the FIFO; " << r.err;
+    EXPECT_EQ(count_occurrences(r.err, "\n"), 1) << "one line: " << r.err;
+    EXPECT_NE(r.err.find(dir + ": " + c.says), std::string::npos) << r.err;
+  }
+}
+
+TEST(DicomSeries, SubFoldersAreSkippedAndOtherFilesAreNoSlices) {
+  // A sub-folder (or a link to one) is another series or an export's extras: skipped, and said so;
+  // a dot file (.DS_Store) or a note is a regular file the scan finds is not DICOM.
+  ScratchDir d;
+  write_volume(tiny_case_ct(), d.file("ct.nii.gz"));
+  write_series(d.file("ct.nii.gz"), d.file("series"));
+  const Volume clean = read_volume(d.file("series"));
+  std::filesystem::create_directories(d.file("series/extras"));
+  std::filesystem::create_directory_symlink(d.file("series/extras"), d.file("series/link_to_extras"));
+  write_bytes(d.file("series/.DS_Store"), std::string("\0\0\0\1Bud1", 8));
+  write_bytes(d.file("series/notes.txt"), "the scanner's notes\n");
+  const Volume v = read_volume(d.file("series"));
+  EXPECT_TRUE(v.same_voxels(clean));
+  EXPECT_TRUE(v.geometry().same_grid(clean.geometry(), 0.0));
+  const CliResult r = run_pneumo_within(60, "info " + d.file("series"));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("skipped the sub-folder extras"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("skipped the sub-folder link_to_extras"), std::string::npos) << r.err;
 }
 
 TEST(DicomSeries, ASceneTakesTheSeriesFolderAsItsCtAndSolvesTheSameCase) {

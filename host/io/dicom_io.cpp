@@ -1,13 +1,15 @@
 #include "io/dicom_io.h"
 
-#include <gdcmDirectory.h>
 #include <gdcmImage.h>
 #include <gdcmImageReader.h>
 #include <gdcmPixelFormat.h>
 #include <gdcmScanner.h>
 #include <gdcmTag.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -17,6 +19,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/log.h"
 #include "io/volume_io.h"
 
 namespace pneumo {
@@ -66,6 +69,35 @@ std::string name_of(const std::string& path) { return std::filesystem::path(path
 
 }  // namespace
 
+SeriesFolder classify_series_entries(const std::string& dir, std::vector<FolderEntry> entries) {
+  std::sort(entries.begin(), entries.end(), [](const FolderEntry& a, const FolderEntry& b) { return a.name < b.name; });
+  SeriesFolder out;
+  for (const FolderEntry& e : entries) {
+    const std::string path = (std::filesystem::path(dir) / e.name).string();
+    if (e.probe.kind == FileKind::Regular) out.files.push_back(path);
+    else if (e.probe.kind == FileKind::Folder) out.skipped_folders.push_back(e.name);
+    else
+      throw file_error(dir, e.name + " " + file_kind_problem(e.probe, "move it out of the folder (every file in "
+                                                                            "a series folder is read)"));
+  }
+  return out;
+}
+
+SeriesFolder list_series_folder(const std::string& dir) {
+  std::vector<FolderEntry> entries;
+  std::error_code ec;
+  std::filesystem::directory_iterator it(dir, ec), end;
+  for (; !ec && it != end; it.increment(ec)) {
+    const std::string path = it->path().string();
+    FileProbe probe = probe_file(path);
+    // GDCM's scan would pass over a file it cannot open as one that is not DICOM: a slice lost.
+    if (probe.kind == FileKind::Regular && ::access(path.c_str(), R_OK) != 0) probe = {FileKind::Unreadable, errno, {}, 0};
+    entries.push_back({it->path().filename().string(), probe});
+  }
+  if (ec) throw file_error(dir, "cannot list the folder: " + ec.message());
+  return classify_series_entries(dir, std::move(entries));
+}
+
 bool is_dicom_series_folder(const std::string& path) {
   std::error_code ec;
   return std::filesystem::is_directory(path, ec);
@@ -73,16 +105,17 @@ bool is_dicom_series_folder(const std::string& path) {
 
 Volume read_dicom_series(const std::string& dir) {
   if (!is_dicom_series_folder(dir)) throw file_error(dir, "not a folder (a DICOM series is read from its folder)");
-  gdcm::Directory listing;
-  listing.Load(dir, false);
+  const SeriesFolder listing = list_series_folder(dir);
+  for (const std::string& folder : listing.skipped_folders)
+    log::info(dir + ": skipped the sub-folder " + folder + " (a series is read from its own folder only)");
   gdcm::Scanner scanner;
   for (const gdcm::Tag& t : {kModality, kSeriesUid, kPosition, kOrientation, kRows, kColumns, kPixelSpacing, kFrames})
     scanner.AddTag(t);
-  if (!scanner.Scan(listing.GetFilenames())) throw file_error(dir, "cannot scan the folder's files for DICOM");
+  if (!scanner.Scan(listing.files)) throw file_error(dir, "cannot scan the folder's files for DICOM");
 
   std::vector<std::string> files;
   std::set<std::string> series;
-  for (const std::string& f : listing.GetFilenames()) {
+  for (const std::string& f : listing.files) {
     if (!scanner.IsKey(f.c_str())) continue;   // not DICOM: a DICOMDIR's neighbours, notes, thumbnails
     files.push_back(f);
     series.insert(trimmed(scanner.GetValue(f.c_str(), kSeriesUid)));

@@ -10,11 +10,40 @@
 // series, a modality other than CT, multi-frame or colour images, slices whose size, orientation or
 // pixel spacing differ, two slices at one position, uneven gaps (a missing slice), and a tilted
 // gantry (positions not along the normal).
+//
+// The folder is listed by pneumo, every entry accounted for (GDCM's own listing stops at the first
+// entry it cannot stat, so a dangling link halfway read half a CT): regular files, and links to
+// them, are read; sub-folders (and links to them) are skipped and logged, as a series is one
+// folder; anything else (a dangling link, a FIFO, a socket, a device, an entry that cannot be
+// examined) is refused naming the entry. No entry is opened to classify it: a FIFO's open blocks.
+// Regular files that are not DICOM (notes, thumbnails, .DS_Store) are skipped by the scan.
 #include <string>
+#include <vector>
 
+#include "core/input_file.h"
 #include "io/volume.h"
 
 namespace pneumo {
+
+/// One entry of a series folder: its name and what it is (links followed).
+struct FolderEntry {
+  std::string name;
+  FileProbe probe;
+};
+
+/// A series folder's entries sorted out: the files to scan (paths, sorted by name) and the
+/// sub-folders skipped (names).
+struct SeriesFolder {
+  std::vector<std::string> files;
+  std::vector<std::string> skipped_folders;
+};
+
+/// Sorts out `entries` of folder `dir` as the header says; InputError naming `dir` and the first
+/// entry by name that is neither a file nor a folder. Pure, so the rule is fuzzed on its own.
+SeriesFolder classify_series_entries(const std::string& dir, std::vector<FolderEntry> entries);
+
+/// Lists `dir` (std::filesystem, not recursive) and classifies each entry with probe_file.
+SeriesFolder list_series_folder(const std::string& dir);
 
 /// Whether `path` is a folder, which read_volume then reads as a DICOM series.
 bool is_dicom_series_folder(const std::string& path);

@@ -1,8 +1,9 @@
 // Writes the fuzzers' seed corpora: small valid volumes of every voxel type in every format pneumo
 // reads (so the fuzzers start from files that pass every header check and mutate from there), and
 // the scenes shipped in scenes/; and the hostile headers of tests/hostile_headers.h, so mutation
-// starts at the size checks too; and request bodies and ports as `pneumo serve`'s page sends them.
-// Usage: make_seeds SOURCE_DIR OUT_DIR; OUT_DIR/{nifti,metaimage,nrrd,scene,request_json}.
+// starts at the size checks too; request bodies and ports as `pneumo serve`'s page sends them; and
+// small folders for the DICOM listing.
+// Usage: make_seeds SOURCE_DIR OUT_DIR; OUT_DIR/{nifti,metaimage,nrrd,scene,request_json,dicom_folder}.
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -24,7 +25,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path source = argv[1], out = argv[2];
-  for (const char* sub : {"nifti", "metaimage", "nrrd", "scene", "request_json"}) fs::create_directories(out / sub);
+  for (const char* sub : {"nifti", "metaimage", "nrrd", "scene", "request_json", "dicom_folder"})
+    fs::create_directories(out / sub);
   std::mt19937 rng(20261124);
   const VoxelType types[] = {VoxelType::Int8,   VoxelType::UInt8,  VoxelType::Int16,   VoxelType::UInt16,
                              VoxelType::Int32,  VoxelType::UInt32, VoxelType::Float32, VoxelType::Float64};
@@ -63,5 +65,13 @@ int main(int argc, char** argv) {
   };
   for (std::size_t i = 0; i < std::size(requests); ++i)
     std::ofstream(out / "request_json" / ("r" + std::to_string(i) + ".json")) << requests[i];
+  // Folders for fuzz_dicom_folder (entry: kind, name length, name, a file's length and bytes): files
+  // and a sub-folder; the same with a FIFO among them; every kind once.
+  const std::string folders[] = {std::string("\0\2\0\1\3abc\0\3\1\2\0\1\1\2\3\4", 18),
+                                 std::string("\0\1\0\1xy\6\1\1\2\0\1\2\0z", 15),
+                                 std::string("\0\0\1\0\1\1\1\2\2\1\3\3\1\4\4\1\5\5\1\6\6\1\0", 23)};
+  int f = 0;
+  for (const std::string& bytes : folders)
+    std::ofstream(out / "dicom_folder" / ("folder" + std::to_string(f++)), std::ios::binary) << bytes;
   return 0;
 }
