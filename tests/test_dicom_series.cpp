@@ -93,6 +93,9 @@ TEST(DicomSeries, WhatIsNotOneCtVolumeIsRefusedSayingWhy) {
       {"drop=4", "not evenly spaced"},
       {"tilt_mm=1", "tilted gantry"},
       {"short_pixels=1", "bytes where Rows × Columns need"},
+      // GDCM reads a slope of 0 as 1; 1e300 made infinite voxels: the tags are refused, naming them.
+      {"tag_slope=0", ".dcm: Rescale Slope (0028,1053) is 0"},
+      {"tag_slope=1e300", ".dcm: Rescale Slope (0028,1053) 1e+300 and Intercept (0028,1052) -2048 map its stored"},
   };
   int index = 0;
   for (const auto& c : cases) {

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -27,7 +28,11 @@ namespace {
 
 const gdcm::Tag kModality(0x0008, 0x0060), kSeriesUid(0x0020, 0x000e), kPosition(0x0020, 0x0032),
     kOrientation(0x0020, 0x0037), kRows(0x0028, 0x0010), kColumns(0x0028, 0x0011), kPixelSpacing(0x0028, 0x0030),
-    kFrames(0x0028, 0x0008);
+    kFrames(0x0028, 0x0008), kRescaleIntercept(0x0028, 0x1052), kRescaleSlope(0x0028, 0x1053);
+
+// The most HU a CT holds is a few ten thousand (metal on an extended scale); a rescale that maps
+// stored values beyond this is a wrong tag, not a body (1e300 gave infinite voxels).
+constexpr double kMostAbsHu = 1e5;
 
 std::string trimmed(const char* s) {
   std::string t = s ? s : "";
@@ -66,6 +71,35 @@ struct Slice {
 };
 
 std::string name_of(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
+/// HU = slope × stored + intercept (PS3.3 C.11.1.1.2), from the tags as the file holds them: GDCM's
+/// Image::GetSlope() turns a slope of 0 into 1, which would read a wrong file as a plausible CT.
+struct Rescale {
+  double slope = 1.0, intercept = 0.0;
+};
+
+Rescale rescale_of(const std::string& dir, const std::string& file, const char* slope, const char* intercept) {
+  Rescale r;
+  if (slope && !trimmed(slope).empty())
+    r.slope = numbers(dir, file, slope, 1, "Rescale Slope (0028,1053)")[0];
+  if (intercept && !trimmed(intercept).empty())
+    r.intercept = numbers(dir, file, intercept, 1, "Rescale Intercept (0028,1052)")[0];
+  if (r.slope == 0.0)
+    throw file_error(dir, file + ": Rescale Slope (0028,1053) is 0, which maps every stored value to one HU: fix the "
+                                "tag (CT exports write 1)");
+  return r;
+}
+
+/// Refuses a rescale that takes the slice's stored values [lo, hi] outside what HU can be.
+void check_rescaled_range(const std::string& dir, const std::string& file, const Rescale& r, double lo, double hi) {
+  const double a = r.slope * lo + r.intercept, b = r.slope * hi + r.intercept;
+  if (std::isfinite(a) && std::isfinite(b) && std::abs(a) <= kMostAbsHu && std::abs(b) <= kMostAbsHu) return;
+  std::ostringstream os;
+  os << file << ": Rescale Slope (0028,1053) " << r.slope << " and Intercept (0028,1052) " << r.intercept
+     << " map its stored values " << lo << " .. " << hi << " to " << std::min(a, b) << " .. " << std::max(a, b)
+     << " HU, beyond the ±" << kMostAbsHu << " HU a CT holds: fix the tags";
+  throw file_error(dir, os.str());
+}
 
 }  // namespace
 
@@ -109,7 +143,8 @@ Volume read_dicom_series(const std::string& dir) {
   for (const std::string& folder : listing.skipped_folders)
     log::info(dir + ": skipped the sub-folder " + folder + " (a series is read from its own folder only)");
   gdcm::Scanner scanner;
-  for (const gdcm::Tag& t : {kModality, kSeriesUid, kPosition, kOrientation, kRows, kColumns, kPixelSpacing, kFrames})
+  for (const gdcm::Tag& t : {kModality, kSeriesUid, kPosition, kOrientation, kRows, kColumns, kPixelSpacing, kFrames,
+                             kRescaleIntercept, kRescaleSlope})
     scanner.AddTag(t);
   if (!scanner.Scan(listing.files)) throw file_error(dir, "cannot scan the folder's files for DICOM");
 
@@ -238,18 +273,24 @@ Volume read_dicom_series(const std::string& dir) {
                                 " bytes where Rows × Columns need " + std::to_string(image.GetBufferLength()));
     buffer.resize(image.GetBufferLength());
     if (!image.GetBuffer(buffer.data())) throw file_error(dir, name_of(slices[s].file) + ": cannot decode its pixels");
-    const double slope = image.GetSlope(), intercept = image.GetIntercept();
-    if (!(std::isfinite(slope) && std::isfinite(intercept) && slope != 0.0))
-      throw file_error(dir, name_of(slices[s].file) + ": Rescale Slope or Intercept is not a usable number");
+    const Rescale rescale = rescale_of(dir, name_of(slices[s].file), value(slices[s].file, kRescaleSlope),
+                                       value(slices[s].file, kRescaleIntercept));
     float* dst = out + s * per_slice;
     auto convert = [&](auto sample) {
       using T = decltype(sample);
       if (buffer.size() < per_slice * sizeof(T))
         throw file_error(dir, name_of(slices[s].file) + ": its pixel data is shorter than Rows × Columns");
+      T lo = std::numeric_limits<T>::max(), hi = std::numeric_limits<T>::lowest();
       for (std::size_t n = 0; n < per_slice; ++n) {
         T raw;
         std::memcpy(&raw, buffer.data() + n * sizeof(T), sizeof(T));
-        dst[n] = float(slope * double(raw) + intercept);
+        lo = std::min(lo, raw), hi = std::max(hi, raw);
+      }
+      check_rescaled_range(dir, name_of(slices[s].file), rescale, double(lo), double(hi));
+      for (std::size_t n = 0; n < per_slice; ++n) {
+        T raw;
+        std::memcpy(&raw, buffer.data() + n * sizeof(T), sizeof(T));
+        dst[n] = float(rescale.slope * double(raw) + rescale.intercept);
       }
     };
     switch (pf.GetScalarType()) {

@@ -11,6 +11,8 @@ through Rescale Slope and Intercept. Used by tests/test_dicom_series.cpp, so tha
     drop=-1                   the index of a slice to leave out (a missing slice), to be refused
     tilt_mm=0                 shift each slice sideways by k * tilt_mm (a tilted gantry), to be refused
     short_pixels=0            1: the last slice's pixel data cut to half of Rows x Columns, to be refused
+    tag_slope=                the Rescale Slope written in the tags instead of slope (pixels still
+                              stored through slope), to be refused: 0, 1e300
 """
 import os
 import random
@@ -33,7 +35,7 @@ def ds(values):
 def main():
     nifti, out = sys.argv[1], sys.argv[2]
     opt = dict(slope="1", intercept="-2048", shuffle="1", modality="CT", split="0", drop="-1", tilt_mm="0",
-               short_pixels="0")
+               short_pixels="0", tag_slope="")
     for arg in sys.argv[3:]:
         key, value = arg.split("=", 1)
         if key not in opt:
@@ -77,6 +79,8 @@ def main():
         d.SamplesPerPixel, d.PhotometricInterpretation = 1, "MONOCHROME2"
         d.BitsAllocated, d.BitsStored, d.HighBit, d.PixelRepresentation = 16, 16, 15, 0
         d.RescaleSlope, d.RescaleIntercept, d.RescaleType = ds([slope])[0], ds([intercept])[0], "HU"
+        if opt["tag_slope"]:
+            d.RescaleSlope = opt["tag_slope"]
         stored = numpy.rint((hu[:, :, k].T - intercept) / slope)   # rows are j, columns i
         if stored.min() < 0 or stored.max() > 65535:
             sys.exit("HU out of the unsigned 16-bit range of this rescale")
