@@ -197,6 +197,57 @@ TEST_P(MeshEstimate, CoversWhatTheBuildTakesWithoutRefusingWhatFits) {
 
 INSTANTIATE_TEST_SUITE_P(SmallPhantom, MeshEstimate, ::testing::Values(1, 2, 4));
 
+/// The outcome of read_volume(path) in a child whose address space may grow `headroom` bytes past what
+/// it has mapped: 1 read, 2 refused by the memory check naming the file, -4 out of memory (bad_alloc).
+long long read_under_headroom(const std::string& path, double headroom) {
+  return in_child([&] {
+    std::ifstream statm("/proc/self/statm");
+    long long pages = 0;
+    statm >> pages;
+    const rlimit lim{rlim_t(pages) * rlim_t(sysconf(_SC_PAGESIZE)) + rlim_t(headroom), RLIM_INFINITY};
+    if (setrlimit(RLIMIT_AS, &lim) != 0) return -2LL;
+    try {
+      return read_volume(path).voxel_count() > 0 ? 1LL : -5LL;
+    } catch (const InputError& e) {
+      return std::string(e.what()).rfind(path + ": an image of 2048 x 2048 x 16 int16 voxels", 0) == 0 ? 2LL : -3LL;
+    } catch (...) {
+      return -4LL;
+    }
+  });
+}
+
+// teem allocates a NRRD's voxels itself and the reader copies them into its Volume: the read peaks at
+// two copies. The check counted one, so under a limit between one and two it passed and the read
+// ended "out of memory" (exit 1) instead of the check's refusal (exit 2). The check counts both.
+TEST(MemoryBudget, ANrrdIsRefusedBeforeItIsReadWhenItsTwoCopiesCannotFit) {
+  if (kAddressSanitizer) GTEST_SKIP() << "address sanitizer: no address-space limit";
+  ScratchDir d;
+  const std::string path = d.file("big.nrrd");
+  {
+    Geometry g;
+    g.dims = {2048, 2048, 16};   // 128 MiB of int16, written gzip as pneumo writes NRRD
+    Volume v(g, VoxelType::Int16);
+    int16_t* p = v.data<int16_t>();
+    for (int64_t n = 0; n < v.voxel_count(); ++n) p[n] = int16_t((n * 7) % 3000 - 1000);
+    write_volume(v, path);
+  }
+  const double payload = 2048.0 * 2048.0 * 16.0 * 2.0;
+  const long long peak_rise_kib = in_child([&] {
+    const long long before = resident_kib();
+    const Volume v = read_volume(path);
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return (long long)(v.voxel_count() > 0 ? u.ru_maxrss - before : -1);
+  });
+  ASSERT_GT(peak_rise_kib, 0);
+  const double estimate = 2.0 * payload + 16.0 * 1048576.0;   // two copies and teem's working memory
+  std::printf("NRRD of %.0f MiB: peak rise %.1f MiB, estimate %.0f MiB\n", payload / 1048576.0,
+              double(peak_rise_kib) / 1024.0, estimate / 1048576.0);
+  EXPECT_LE(double(peak_rise_kib) * 1024.0, estimate) << "the read takes more than the check counts";
+  EXPECT_EQ(read_under_headroom(path, 1.5 * payload), 2) << "-4: out of memory past the check";
+  EXPECT_EQ(read_under_headroom(path, 2.3 * payload), 1) << "what fits is read";
+}
+
 TEST(MeshEstimate, TheReserveOfTheSolverIsCountedPerNodeAndTetrahedron) {
   const PhantomRoles& roles = small_phantom_roles();
   MeshOptions opt;

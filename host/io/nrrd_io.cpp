@@ -16,6 +16,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/input_file.h"
+#include "core/memory_budget.h"
 #include "io/volume_io.h"
 
 namespace pneumo {
@@ -224,6 +225,22 @@ uint64_t most_voxel_bytes(const std::string& encoding, uint64_t available, std::
   return UINT64_MAX;
 }
 
+/// teem's working memory beside the voxels while it reads (zlib's state and window, its line
+/// buffers): a few MiB, rounded up.
+constexpr uint64_t kTeemWorkingBytes = 16u << 20;
+
+/// The memory check before the voxels are read. teem allocates them itself (nrrdLoad) and they are
+/// then copied into the Volume, so both are held at the copy: the check counts two, and teem's
+/// working memory. (Counting one, a limit between the two passed the check and the read ended
+/// "out of memory", exit 1.)
+void require_nrrd_memory(const std::string& path, const Geometry& g, VoxelType t) {
+  std::ostringstream what;
+  what << path << ": an image of " << g.dims[0] << " x " << g.dims[1] << " x " << g.dims[2] << " "
+       << voxel_type_name(t) << " voxels, read through teem's own copy of them,";
+  require_memory(2 * uint64_t(g.voxel_count()) * voxel_size(t) + kTeemWorkingBytes, what.str(),
+                 "crop or resample the image, or free memory");
+}
+
 }  // namespace
 
 Volume read_nrrd(const std::string& path) {
@@ -263,7 +280,7 @@ Volume read_nrrd(const std::string& path) {
       throw file_error(path, os.str());
     }
   }
-  require_volume_memory(path, g, type);
+  require_nrrd_memory(path, g, type);
 
   NrrdPtr n(nrrdNew());
   IoPtr io(nrrdIoStateNew());   // ours, not one teem makes itself: its error paths then leak nothing
