@@ -21,10 +21,18 @@ Run add_convert(CLI::App& app) {
   cmd->add_flag("--force", *force, "Overwrite OUTPUT if it exists");
   return [=] {
     volume_format_from_path(*out);   // an unknown name is refused before the input is read
-    if (std::filesystem::exists(*out) && !*force) throw InputError(*out + ": already exists; use --force to overwrite");
-    check_writable_target(*out);
+    // Every file the conversion writes: a .mhd's data file beside it is overwritten as surely as the header.
+    const WriteOptions options;
+    for (const std::string& file : files_written_by(*out, options)) {
+      std::error_code ec;   // symlink_status: a link under the name, even a dangling one, is there too
+      const bool there = std::filesystem::symlink_status(file, ec).type() != std::filesystem::file_type::not_found;
+      if (there && !*force)
+        throw InputError(file + ": already exists" + (file == *out ? "" : " (the data file " + *out + " names)") +
+                         "; use --force to overwrite");
+      check_writable_target(file);
+    }
     const Volume v = read_volume(*in);
-    write_volume(v, *out);
+    write_volume(v, *out, options);
     log::info("wrote " + *out);
     return 0;
   };

@@ -621,6 +621,10 @@ Volume read_metaimage(const std::string& path) {
   return v;
 }
 
+std::string metaimage_data_path(const std::string& mhd_path, bool compressed) {
+  return fs::path(mhd_path).replace_extension(compressed ? ".zraw" : ".raw").string();
+}
+
 void write_metaimage(const Volume& v, const std::string& path, bool compress) {
   check_writable_target(path);
   const VolumeFormat format = volume_format_from_path(path);
@@ -646,8 +650,8 @@ void write_metaimage(const Volume& v, const std::string& path, bool compress) {
     write_atomic(path, {{header.data(), header.size()}, {data, data_bytes}});
     return;
   }
-  const std::string data_name = fs::path(path).filename().replace_extension(compress ? ".zraw" : ".raw").string();
-  const std::string data_path = (fs::path(path).parent_path() / data_name).string();
+  const std::string data_path = metaimage_data_path(path, compress);
+  const std::string data_name = fs::path(data_path).filename().string();
   const std::string header = header_text(v, compress, data_bytes, data_name);
   write_atomic(data_path, {{data, data_bytes}});
   try {

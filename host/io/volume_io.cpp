@@ -58,6 +58,12 @@ void write_volume(const Volume& v, const std::string& path, const WriteOptions& 
   }
 }
 
+std::vector<std::string> files_written_by(const std::string& path, const WriteOptions& opt) {
+  if (volume_format_from_path(path) == VolumeFormat::MetaImageSplit)
+    return {path, metaimage_data_path(path, opt.compress_metaimage)};
+  return {path};
+}
+
 uint64_t checked_payload_bytes(const std::string& path, const int64_t dims[3], std::size_t bytes_per_voxel) {
   uint64_t total = bytes_per_voxel;
   for (int a = 0; a < 3; ++a) {

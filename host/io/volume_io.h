@@ -4,6 +4,7 @@
 // its folder (io/dicom_io.h). Every reader checks a header against the file before allocating what it promises,
 // and reports any problem as an InputError naming the file. Every writer is atomic.
 #include <string>
+#include <vector>
 
 #include "io/volume.h"
 
@@ -23,6 +24,13 @@ struct WriteOptions {
 };
 /// Writes atomically: a failed or interrupted write leaves no file at `path`.
 void write_volume(const Volume& v, const std::string& path, const WriteOptions& opt = {});
+
+/// Every file write_volume(v, path, opt) writes: `path`, and for a .mhd the data file beside it. A
+/// command that must not overwrite a file unasked checks each of them.
+std::vector<std::string> files_written_by(const std::string& path, const WriteOptions& opt = {});
+
+/// The data file a .mhd header names and is written beside: its name with .raw, or .zraw compressed.
+std::string metaimage_data_path(const std::string& mhd_path, bool compressed);
 
 // Per-format entry points (used by the dispatchers above and by tests).
 Volume read_nifti(const std::string& path);
