@@ -101,6 +101,25 @@ void check_rescaled_range(const std::string& dir, const std::string& file, const
   throw file_error(dir, os.str());
 }
 
+/// Whether a file starts as a DICOM file does, from its first 132 bytes: a DICOM file (Part 10) has
+/// "DICM" after a 128-byte preamble; an older one without it (ACR-NEMA) starts with a data set whose
+/// first group is 0008, little-endian. Everything else is passed over before GDCM sees it: Debian's
+/// GDCM 3.0 stops the process on an assert() while scanning some short files that are neither (a
+/// fuzzer's 9 bytes, 02 00 2b 28 02 00 2b 01 02).
+bool starts_as_dicom(const std::string& path) {
+  unsigned char head[132] = {};
+  InputFile in(path, "the slice");
+  std::size_t got = 0;
+  while (got < sizeof head) {
+    const ssize_t n = ::read(in.fd(), head + got, sizeof head - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    got += std::size_t(n);
+  }
+  if (got == sizeof head && std::memcmp(head + 128, "DICM", 4) == 0) return true;
+  return got >= 8 && head[0] == 0x08 && head[1] == 0x00;
+}
+
 }  // namespace
 
 SeriesFolder classify_series_entries(const std::string& dir, std::vector<FolderEntry> entries) {
@@ -146,11 +165,14 @@ Volume read_dicom_series(const std::string& dir) {
   for (const gdcm::Tag& t : {kModality, kSeriesUid, kPosition, kOrientation, kRows, kColumns, kPixelSpacing, kFrames,
                              kRescaleIntercept, kRescaleSlope})
     scanner.AddTag(t);
-  if (!scanner.Scan(listing.files)) throw file_error(dir, "cannot scan the folder's files for DICOM");
+  std::vector<std::string> candidates;
+  for (const std::string& f : listing.files)
+    if (starts_as_dicom(f)) candidates.push_back(f);
+  if (!scanner.Scan(candidates)) throw file_error(dir, "cannot scan the folder's files for DICOM");
 
   std::vector<std::string> files;
   std::set<std::string> series;
-  for (const std::string& f : listing.files) {
+  for (const std::string& f : candidates) {
     if (!scanner.IsKey(f.c_str())) continue;   // not DICOM: a DICOMDIR's neighbours, notes, thumbnails
     files.push_back(f);
     series.insert(trimmed(scanner.GetValue(f.c_str(), kSeriesUid)));
