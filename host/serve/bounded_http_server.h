@@ -43,6 +43,9 @@ class BoundedHttpServer : public httplib::Server {
   /// queue; the system's net.core.somaxconn caps it). False when it could not be.
   bool raise_listen_backlog();
   const ConnectionLimits& limits() const { return limits_; }
+  /// Serves one connected socket as an accepted one is served (then closes it), on the caller's
+  /// thread, while the server listens: for the fuzz target, which feeds it socket pairs.
+  bool serve_connection(socket_t sock) { return process_and_close_socket(sock); }
 
  private:
   bool process_and_close_socket(socket_t sock) override;

@@ -2,8 +2,8 @@
 // reads (so the fuzzers start from files that pass every header check and mutate from there), and
 // the scenes shipped in scenes/; and the hostile headers of tests/hostile_headers.h, so mutation
 // starts at the size checks too; request bodies and ports as `pneumo serve`'s page sends them; and
-// small folders for the DICOM listing.
-// Usage: make_seeds SOURCE_DIR OUT_DIR; OUT_DIR/{nifti,metaimage,nrrd,scene,request_json,dicom_folder}.
+// small folders for the DICOM listing; raw HTTP connections.
+// Usage: make_seeds SOURCE_DIR OUT_DIR; OUT_DIR/{nifti,metaimage,nrrd,scene,request_json,dicom_folder,http_request}.
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path source = argv[1], out = argv[2];
-  for (const char* sub : {"nifti", "metaimage", "nrrd", "scene", "request_json", "dicom_folder"})
+  for (const char* sub : {"nifti", "metaimage", "nrrd", "scene", "request_json", "dicom_folder", "http_request"})
     fs::create_directories(out / sub);
   std::mt19937 rng(20261124);
   const VoxelType types[] = {VoxelType::Int8,   VoxelType::UInt8,  VoxelType::Int16,   VoxelType::UInt16,
@@ -73,5 +73,17 @@ int main(int argc, char** argv) {
   int f = 0;
   for (const std::string& bytes : folders)
     std::ofstream(out / "dicom_folder" / ("folder" + std::to_string(f++)), std::ios::binary) << bytes;
+  // Connections as a browser opens them: a status poll, two requests kept alive, a JSON POST, one
+  // cut off in its headers.
+  const char* connections[] = {
+      "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n",
+      "GET /api/status HTTP/1.1\r\nHost: localhost\r\nConnection: keep-alive\r\n\r\n"
+      "GET /api/status HTTP/1.1\r\nHost: localhost\r\n\r\n",
+      "POST /api/inflate HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+      "Content-Length: 21\r\n\r\n{\"pressure_mmhg\": 12}",
+      "GET /api/status HTTP/1.1\r\nHost: 127.0",
+  };
+  for (std::size_t i = 0; i < std::size(connections); ++i)
+    std::ofstream(out / "http_request" / ("c" + std::to_string(i) + ".txt"), std::ios::binary) << connections[i];
   return 0;
 }
