@@ -24,6 +24,7 @@
 // step.
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/log.h"
 #include "solve/conjugate_gradients.h"
@@ -46,8 +47,10 @@ double load_work(const Mesh& m, const ForceModel& model, const std::vector<Vec3>
     for (int64_t n = 0; n < m.node_count(); ++n) w += alpha * m.mass_kg[n] * model.gravity_m_s2.dot(d[n]);
   if (model.pressure_pa == 0.0) return w;
   const int64_t R = int64_t(m.load_tet.size());
-  double wp = 0.0;
-#pragma omp parallel for reduction(+ : wp) schedule(static) if (R > 20000)
+  // Each load's work on its own, summed after in the loads' order: a parallel reduction would add in
+  // an order that follows the thread count, and the line search's decisions with it.
+  std::vector<double> work(std::size_t(R), 0.0);
+#pragma omp parallel for schedule(static) if (R > 20000)
   for (int64_t l = 0; l < R; ++l) {
     const auto& q = m.tets[m.load_tet[l]];
     double simpson = 0.0;
@@ -60,8 +63,10 @@ double load_work(const Mesh& m, const ForceModel& model, const std::vector<Vec3>
       for (int i = 0; i < 4; ++i) fd -= model.pressure_pa * cofactor_times(e1, e2, e3, m.load_c[l][i]).dot(d[q[i]]);
       simpson += (k == 1 ? 4.0 : 1.0) * fd;
     }
-    wp += alpha / 6.0 * simpson;
+    work[std::size_t(l)] = alpha / 6.0 * simpson;
   }
+  double wp = 0.0;
+  for (const double v : work) wp += v;
   return w + wp;
 }
 
