@@ -17,6 +17,7 @@
 #include "common/cpu_load.h"
 #include "common/stats.h"
 #include "core/atomic_file.h"
+#include "core/child_process.h"
 #include "core/error.h"
 #include "phantom/phantom.h"
 
@@ -67,12 +68,13 @@ struct RunSample {
 RunSample run_once(const fs::path& exe, const fs::path& scene, const fs::path& out, const std::string& device) {
   RunSample r;
   const fs::path log = out.string() + ".log";
-  const std::string command = "'" + exe.string() + "' -q run '" + scene.string() + "' --out '" + out.string() +
-                              "' --force --device " + device + " > '" + log.string() + "' 2>&1";
   const fs::file_time_type start_file = fs::file_time_type::clock::now();
   const auto t0 = std::chrono::steady_clock::now();
   const CpuSample a = cpu_sample();
-  const int status = std::system(command.c_str());
+  // An argument vector, never a shell: the folders' names reach pneumo as they are.
+  const int status = run_program({exe.string(), "-q", "run", scene.string(), "--out", out.string(), "--force",
+                                  "--device", device},
+                                 log.string());
   const CpuSample b = cpu_sample();
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.other_cores = other_cores(a, b);   // the child, waited for, counts as this process's own

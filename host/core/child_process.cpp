@@ -31,7 +31,7 @@ std::optional<std::string> find_program(const std::string& name) {
   return std::nullopt;
 }
 
-int run_program(const std::vector<std::string>& argv) {
+int run_program(const std::vector<std::string>& argv, const std::string& output_path) {
   if (argv.empty()) return -1;
   std::vector<std::string> args = argv;   // posix_spawn takes char* const[]
   std::vector<char*> pointers;
@@ -42,6 +42,10 @@ int run_program(const std::vector<std::string>& argv) {
   // A program that asks a question (ffmpeg's "overwrite?") reads end of file instead of waiting on
   // the user's terminal.
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  if (!output_path.empty()) {
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, output_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  }
   pid_t pid = -1;
   const int started = posix_spawnp(&pid, args[0].c_str(), &actions, nullptr, pointers.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
