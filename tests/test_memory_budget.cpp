@@ -15,6 +15,7 @@
 #include <string>
 
 #include "cli_test_support.h"
+#include "sanitizer_support.h"
 #include "core/error.h"
 #include "core/memory_budget.h"
 #include "io/volume_io.h"
@@ -25,18 +26,6 @@ namespace pneumo {
 namespace {
 
 using namespace testing_support;
-
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;   // its shadow memory maps terabytes: no ulimit -v
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kAddressSanitizer = true;
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
 
 TEST(MemoryBudget, ARefusalGivesBothFiguresTheLimitAndTheAdvice) {
   const MemoryBudget budget{uint64_t(1) << 30, "the address-space limit, ulimit -v"};

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "cli_test_support.h"
+#include "sanitizer_support.h"
 #include "core/error.h"
 #include "core/input_file.h"
 #include "io/label_table.h"
@@ -27,18 +28,6 @@ namespace pneumo {
 namespace {
 
 using namespace testing_support;
-
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;   // its shadow memory maps terabytes: no ulimit -v
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kAddressSanitizer = true;
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
 
 /// `pneumo ARGS` within 20 s and, without a sanitizer, 4 GB of address space: a reader that waits
 /// on a FIFO is killed (exit 124), one that reads /dev/zero without end runs out (not exit 2).
