@@ -110,18 +110,31 @@ TEST_P(ForcesClVsRef, RandomMeshesAndStatesMatchTheReference) {
 }
 
 TEST_P(ForcesClVsRef, StateStaysOnTheDeviceBetweenEvaluations) {
-  // Evaluating twice without uploading again gives the same bits: nothing is lost or re-uploaded.
+  // Evaluating twice without uploading again gives the same bits: nothing is lost or re-uploaded. And
+  // both are the reference's forces (the tolerance above), not zeros: two evaluations that both lost
+  // the state would agree too.
   auto ctx = ocl::Context::shared(ocl::parse_device_spec(GetParam()));
   std::mt19937 rng(7);
-  const RandomCase c = random_case(rng);
+  RandomCase c = random_case(rng);
+  c.model.pressure_pa = 2000.0;   // a load on every case: the forces cannot all be zero
   ClForceEvaluator cl(*ctx, c.mesh);
   cl.upload_state(c.x, c.v);
-  std::vector<Vec3> first, second;
+  std::vector<Vec3> first, second, ref;
   cl.evaluate(c.model);
   cl.download_forces(first);
   cl.evaluate(c.model);
   cl.download_forces(second);
   EXPECT_EQ(first, second);
+  ForceEvaluator(c.mesh).evaluate(c.model, c.x, c.v, ref);
+  const std::vector<double> scale = force_scales(c);
+  constexpr double kEps32 = 1.0 / (1 << 23);
+  double largest = 0.0;
+  for (int64_t n = 0; n < c.mesh.node_count(); ++n) {
+    largest = std::max(largest, second[n].norm());
+    for (int a = 0; a < 3; ++a)
+      ASSERT_LE(std::abs(second[n][a] - ref[n][a]), 32 * kEps32 * scale[n] + 1e-30) << "node " << n << " axis " << a;
+  }
+  EXPECT_GT(largest, 0.0) << "the device returned no force at all";
 }
 
 TEST_P(ForcesClVsRef, FreeNodesOnlySkipsExactlyTheFullyHeldNodes) {
