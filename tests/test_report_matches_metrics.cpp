@@ -62,7 +62,7 @@ std::string text_of(const std::string& html) {
 }
 
 struct Table {
-  std::string kind;      // "metrics", "array", "timing", "landmarks", "other"
+  std::string kind;      // "metrics", "array", "timing", "landmarks", "landmark_errors", "other"
   std::string heading;   // the <h3> an array table is named by
   std::vector<std::vector<std::string>> rows;   // the header row first; cell text
 };
@@ -80,6 +80,7 @@ std::vector<Table> tables_of(const std::string& html) {
     const std::string before = html.substr(at >= 200 ? at - 200 : 0, at >= 200 ? 200 : at);
     if (tag == "<table class=\"metrics\">") t.kind = "metrics";
     else if (tag == "<table class=\"timing\">") t.kind = "timing";
+    else if (tag == "<table class=\"landmark-errors\">") t.kind = "landmark_errors";
     else if (ends_with(before, "<h2>Landmarks</h2>\n")) t.kind = "landmarks";
     else if (ends_with(before, "</h3>\n")) {
       t.kind = "array";
@@ -357,6 +358,7 @@ void expect_report_matches(const std::string& html, const json& m) {
         {"simulated (mm)", "simulated_mm"},
         {"displacement (mm)", "displacement_mm"},
         {"|displacement| (mm)", "displacement_norm_mm"},
+        {"measured after (mm)", "measured_after_ct_mm"},
         {"error (mm)", "error_mm"}};
     const auto& header = t->rows[0];
     ASSERT_EQ(header.at(0), "landmark");
@@ -368,6 +370,31 @@ void expect_report_matches(const std::string& html, const json& m) {
         const std::string where = "landmarks.points[" + std::to_string(r) + "]." + key;
         if (points[r].contains(key)) expect_value(where, t->rows[r + 1].at(c), points[r][key], 1.0);
         else EXPECT_EQ(t->rows[r + 1].at(c), "") << where;
+      }
+    }
+    // Measured: every summary figure against the CT after inflation, each in its own row, in mm.
+    if (m["landmarks"].value("measured", false)) {
+      const Table* e = nullptr;
+      for (const Table& c : tables)
+        if (c.kind == "landmark_errors") e = &c;
+      ASSERT_NE(e, nullptr) << "the measured landmarks' summary is not on the page";
+      const std::map<std::string, std::string> pointer_of_row = {
+          {"Alignment of the two CTs (RMS)", "/landmarks/alignment_rms_mm"},
+          {"Mean position error", "/landmarks/position_error_mm"},
+          {"Mean displacement error, horizontal", "/landmarks/displacement_error_mm/horizontal"},
+          {"Mean displacement error, ventrodorsal", "/landmarks/displacement_error_mm/ventrodorsal"},
+          {"Mean displacement error, cephalocaudal", "/landmarks/displacement_error_mm/cephalocaudal"}};
+      std::set<std::string> shown;
+      for (std::size_t r = 1; r < e->rows.size(); ++r) {
+        ASSERT_TRUE(pointer_of_row.count(e->rows[r].at(0))) << e->rows[r].at(0);
+        const json::json_pointer at(pointer_of_row.at(e->rows[r].at(0)));
+        expect_value(at.to_string(), e->rows[r].at(1), m.at(at), 1.0);
+        shown.insert(at.to_string());
+      }
+      for (const auto& [row, pointer] : pointer_of_row) {
+        if (m.contains(json::json_pointer(pointer))) {
+          EXPECT_TRUE(shown.count(pointer)) << pointer << " is not on the page";
+        }
       }
     }
   }
@@ -423,9 +450,13 @@ TEST(ReportMatchesMetrics, EveryFigureOfEveryKnownKeyIsItsMetric) {
                     {"points",
                      {{{"name", "umbilicus"}, {"ct_mm", {1.5, 108.3, -20.7}}, {"simulated_mm", {1.6, 131.9, -21.4}},
                        {"displacement_mm", {0.1, 23.6, -0.7}}, {"displacement_norm_mm", 23.61},
-                       {"error_mm", 2.345}},
+                       {"measured_after_ct_mm", {1.2, 129.8, -22.6}}, {"error_mm", 2.345}},
                       {{"name", "L3"}, {"ct_mm", {0.3, -40.2, -60.9}}, {"simulated_mm", {0.3, -40.2, -60.9}},
-                       {"displacement_mm", {0.0, 0.0, 0.0}}, {"displacement_norm_mm", 0.0}, {"error_mm", 0.4321}}}}};
+                       {"displacement_mm", {0.0, 0.0, 0.0}}, {"displacement_norm_mm", 0.0},
+                       {"measured_after_ct_mm", {0.7, -40.1, -61.2}}, {"error_mm", 0.4321}}}},
+                    {"alignment_rms_mm", 0.8765},
+                    {"position_error_mm", 1.3886},
+                    {"displacement_error_mm", {{"horizontal", 0.3456}, {"ventrodorsal", 1.0987}, {"cephalocaudal", 0.6543}}}};
   ReportContent c;
   c.title = "every key";
   c.metrics = m;

@@ -191,14 +191,30 @@ void landmarks(const json& m, std::ostringstream& o) {
   const bool measured = m["landmarks"].value("measured", false);
   o << "<h2>Landmarks</h2>\n<table><tr><th>landmark</th><th>on the CT (mm)</th><th>simulated (mm)</th>"
        "<th>displacement (mm)</th><th>|displacement| (mm)</th>"
-    << (measured ? "<th>error (mm)</th>" : "") << "</tr>\n";
+    << (measured ? "<th>measured after (mm)</th><th>error (mm)</th>" : "") << "</tr>\n";
   for (const json& p : pts) {
     o << "<tr><td>" << escape_markup(p.value("name", std::string())) << "</td>";
     for (const char* k : {"ct_mm", "simulated_mm", "displacement_mm", "displacement_norm_mm"})
       o << "<td>" << (p.contains(k) ? escape_markup(cell(p[k])) : "") << "</td>";
-    if (measured) o << "<td>" << (p.contains("error_mm") ? escape_markup(cell(p["error_mm"])) : "") << "</td>";
+    if (measured)
+      for (const char* k : {"measured_after_ct_mm", "error_mm"})
+        o << "<td>" << (p.contains(k) ? escape_markup(cell(p[k])) : "") << "</td>";
     o << "</tr>\n";
   }
+  o << "</table>\n";
+  if (!measured) return;
+  // The summary against the CT taken after inflation: how well the two CTs were aligned (rigidly, on the
+  // landmarks that do not move), and the simulation's mean errors.
+  const json& l = m["landmarks"];
+  const std::pair<const char*, json> summary[] = {
+      {"Alignment of the two CTs (RMS)", l.value("alignment_rms_mm", json())},
+      {"Mean position error", l.value("position_error_mm", json())},
+      {"Mean displacement error, horizontal", l.contains("displacement_error_mm") ? l["displacement_error_mm"].value("horizontal", json()) : json()},
+      {"Mean displacement error, ventrodorsal", l.contains("displacement_error_mm") ? l["displacement_error_mm"].value("ventrodorsal", json()) : json()},
+      {"Mean displacement error, cephalocaudal", l.contains("displacement_error_mm") ? l["displacement_error_mm"].value("cephalocaudal", json()) : json()}};
+  o << "<table class=\"landmark-errors\"><tr><th>against the CT after inflation</th><th>mm</th></tr>\n";
+  for (const auto& [name, value] : summary)
+    if (!value.is_null()) o << "<tr><td>" << name << "</td><td>" << escape_markup(cell(value)) << "</td></tr>\n";
   o << "</table>\n";
 }
 
