@@ -16,6 +16,11 @@ namespace pneumo {
 /// id outside 0…65535, an id given twice or an empty name.
 std::map<int, std::string> read_label_names(const std::string& path);
 
+/// The names a NIfTI-1 label map carries in its header extension (TotalSegmentator's `--ml` output:
+/// a Caret XML <LabelTable>), read without its voxels; empty when it carries none or is not NIfTI-1.
+/// InputError naming the file for a malformed table (a Key that is not an id, a name given twice).
+std::map<int, std::string> read_nifti_label_names(const std::string& path);
+
 struct LabelTableEntry {
   int id = 0;
   std::string name;
