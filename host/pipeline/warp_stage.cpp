@@ -260,11 +260,6 @@ bool round_as_written(std::vector<float>& hu, VoxelType written) {
   return all_int16;
 }
 
-std::map<int, std::string> scene_label_names(const Scene& scene) {
-  if (scene.inputs.label_names.empty()) return {};
-  return read_label_names(scene.inputs.label_names);
-}
-
 std::vector<LabelTableEntry> deformed_label_entries(const Scene& scene, const WarpedCase& w) {
   std::vector<uint8_t> present(65536, 0);
   for (const uint16_t l : w.result.labels) present[l] = 1;

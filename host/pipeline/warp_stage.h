@@ -86,9 +86,6 @@ Volume deformed_ct_volume(const WarpedCase& w);
 /// changes nothing. Returns whether every value then fits_int16_texture (render_volume.h), found in
 /// the same pass, for RenderVolume::from_hu.
 bool round_as_written(std::vector<float>& hu, VoxelType written);
-/// The scene's inputs.label_names (io/label_table.h), empty when unset: read before any long work so
-/// that a bad file is refused at once.
-std::map<int, std::string> scene_label_names(const Scene& scene);
 
 /// The label tables' rows for the deformed labels: background, every id they hold (named from
 /// w.label_names, else "label N") in the renderer's organ colours (else a fixed palette), and the

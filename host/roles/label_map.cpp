@@ -43,9 +43,14 @@ std::string grid_difference(const Geometry& a, const Geometry& b, double tol_mm)
   return "";
 }
 
-std::string id_list(const std::vector<int>& ids) {
+/// "5 (liver), 6 (stomach), 7": ids with their names where `names` has them.
+std::string id_list(const std::vector<int>& ids, const std::map<int, std::string>& names = {}) {
   std::string s;
-  for (std::size_t n = 0; n < ids.size(); ++n) s += (n ? ", " : "") + std::to_string(ids[n]);
+  for (std::size_t n = 0; n < ids.size(); ++n) {
+    s += (n ? ", " : "") + std::to_string(ids[n]);
+    const auto name = names.find(ids[n]);
+    if (name != names.end()) s += " (" + name->second + ")";
+  }
   return s;
 }
 
@@ -99,9 +104,11 @@ void note_label_coverage(const RoleRules& r, const std::vector<uint16_t>& label,
   std::vector<uint8_t> present(65536, 0);
   for (uint16_t id : label) present[id] = 1;  // a byte store per voxel: cheap next to reading the file
   const std::vector<uint8_t> listed = listed_label_ids(r);
+  std::vector<uint8_t> named(65536, 0);   // listed by name, not by the scene: the map need not hold them
+  for (int id : r.ids_from_names) named[std::size_t(id)] = 1;
   std::vector<int> absent, unlisted;
   for (int id = 0; id < 65536; ++id) {
-    if (listed[id] && !present[id]) absent.push_back(id);
+    if (listed[id] && !present[id] && !named[id]) absent.push_back(id);
     if (!listed[id] && present[id] && id != 0) unlisted.push_back(id);
   }
   // A list none of whose ids occurs is a mapping written for another label map (another
@@ -109,24 +116,27 @@ void note_label_coverage(const RoleRules& r, const std::vector<uint16_t>& label,
   const std::pair<const char*, const std::vector<int>*> lists[] = {
       {"wall_labels", &r.wall_labels}, {"viscera_labels", &r.viscera_labels}, {"fixed_labels", &r.fixed_labels}};
   for (const auto& [key, list] : lists) {
-    if (list->empty()) continue;
-    bool any = false;
-    for (int id : *list) any = any || present[std::size_t(id)];
+    bool any = false, own = false;
+    for (int id : *list) {
+      any = any || present[std::size_t(id)];
+      own = own || !named[std::size_t(id)];
+    }
+    if (!own) continue;   // the names' roles, not a mapping the scene wrote
     if (any) continue;
     std::vector<int> ids;
     for (int id = 1; id < 65536 && ids.size() < 20; ++id)
       if (present[id]) ids.push_back(id);
     throw file_error(labels_name, std::string("none of the label ids in roles.") + key + " (" + id_list(*list) +
-                                      ") occurs in the label map (its ids: " + (ids.empty() ? "none" : id_list(ids)) +
+                                      ") occurs in the label map (its ids: " + (ids.empty() ? "none" : id_list(ids, r.label_names)) +
                                       (ids.size() == 20 ? ", ..." : "") +
                                       "): the scene's mapping was written for another label map; fix roles." + key);
   }
   if (!absent.empty())
-    log::warn("roles: label ids listed in the scene but absent from " + labels_name + ": " + id_list(absent) +
+    log::warn("roles: label ids listed in the scene but absent from " + labels_name + ": " + id_list(absent, r.label_names) +
               " (nothing to assign)");
   if (!unlisted.empty())
     log::info("roles: label ids in " + labels_name + " that no role list names (role \"" +
-              role_name(r.unlisted_label_role) + "\" in labels mode, HU rules in auto mode): " + id_list(unlisted));
+              role_name(r.unlisted_label_role) + "\" in labels mode, HU rules in auto mode): " + id_list(unlisted, r.label_names));
 }
 
 }  // namespace pneumo

@@ -1,6 +1,8 @@
 #pragma once
 // How voxels become roles (method.md §2): the scene's "roles" section. By label lists, or by the
 // automatic HU rules (auto_roles.h) with their thresholds, and the air padded around the CT (pad.h).
+#include <map>
+#include <string>
 #include <vector>
 
 #include "domain/types.h"
@@ -8,7 +10,9 @@
 namespace pneumo {
 
 struct RoleRules {
-  RoleSource source = RoleSource::Labels;
+  // "auto": the HU rules fill in what the labels do not decide; a label map's named structures get their
+  // roles by name (by_name), so a scene needs no lists.
+  RoleSource source = RoleSource::Auto;
   std::vector<int> wall_labels, viscera_labels, fixed_labels, other_labels;
   Role unlisted_label_role = Role::Other;
   // Automatic extraction (§2, option). Limits: a single body (largest component), bone by HU only
@@ -18,6 +22,12 @@ struct RoleRules {
   double auto_wall_thickness_mm = 30.0;    // skin + fat + muscle of an adult abdomen
   double auto_wall_max_angle_deg = 100.0;  // anterior (0) and lateral (90) sides; the back is not
   bool auto_use_labels = true;
+  // Ids the lists do not name take the role their structure's name gives (roles/structure_names.h).
+  bool by_name = true;
+  // The names of the label map's ids (for messages, and what by_name read); filled by the scene.
+  std::map<int, std::string> label_names;
+  // The ids of the lists that came from names, not from the scene: a label map need not hold them all.
+  std::vector<int> ids_from_names;
   // Extraperitoneal organs whose front the peritoneum does not reach (the bladder: the space of
   // Retzius lies between it and the wall): undecided tissue anterior to them in the same axial
   // column becomes wall, so no gas opens there (auto_roles.h, rule 5b), and in the slices from

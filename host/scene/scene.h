@@ -9,6 +9,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -190,6 +191,10 @@ Scene parse_scene(const nlohmann::json& j, const std::string& origin_path);
 
 /// Every key at its default.
 Scene default_scene();
+
+/// The names of the label map's ids: inputs.label_names (io/label_table.h) when given, else the names a
+/// NIfTI label map carries in its header (TotalSegmentator's), else none. InputError for a bad file.
+std::map<int, std::string> scene_label_names(const Scene& scene);
 
 /// One item of render.ports as the scene file writes it: every key, as Scene::echo() writes it.
 nlohmann::json port_json(const Port& p);

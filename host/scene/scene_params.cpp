@@ -101,7 +101,8 @@ const Table<RoleRules>& roles_table() {
   const Constraint pad = in(0, 500);
   static const Table<RoleRules> t{
       {"source", &RoleRules::source, "", any(),
-       "Where roles come from (§2): \"labels\" = the role lists below; \"auto\" = extracted from the CT's HU."},
+       "Where roles come from (§2): \"labels\" = the role lists below, nothing else; \"auto\" = the label map's "
+       "named structures (by_name) and the lists, the CT's HU rules for the rest."},
       {"wall_labels", &RoleRules::wall_labels, "", ids,
        "Label ids of the abdominal wall (skin, fat, muscle). A label id may be in one list only."},
       {"viscera_labels", &RoleRules::viscera_labels, "", ids,
@@ -121,6 +122,12 @@ const Table<RoleRules>& roles_table() {
        "the rest of the shell (the back, on the table) is fixed, the body inside it viscera."},
       {"auto_use_labels", &RoleRules::auto_use_labels, "", any(),
        "auto with a label map: voxels whose label is in a role list keep that role; HU rules fill in the rest."},
+      {"by_name", &RoleRules::by_name, "", any(),
+       "auto with a label map whose ids have names (inputs.label_names, or the names TotalSegmentator writes in "
+       "the map's NIfTI header): ids that no list here names take the role their structure's name gives "
+       "(docs/roles.md: peritoneal organs viscera; retroperitoneal ones and the bladder wall, attached; bone, "
+       "thorax and back fixed); auto_prevesical_labels and mesh.attached_labels follow when the scene omits them. "
+       "The lists override the names, id by id."},
       {"auto_prevesical_labels", &RoleRules::auto_prevesical_labels, "", ids,
        "auto with a label map: undecided tissue anterior to these labels in the same axial column becomes wall "
        "(the space of Retzius in front of the bladder is extraperitoneal: no gas opens there), and so does "

@@ -209,6 +209,7 @@ Scene parse_scene(const nlohmann::json& j, const std::string& origin_path) {
     fill_absent(merged, preset_patch(*p, model));
   fill_absent(merged, model_patch(model));
   scene_detail::scene_table().read(s, merged, scene_detail::At{&ctx, ""});
+  scene_detail::assign_roles_by_name(s, merged);
   scene_detail::validate_scene(s, ctx);
   s.path = origin_path;
   s.folder = ctx.folder;
