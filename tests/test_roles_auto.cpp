@@ -65,6 +65,9 @@ Scene auto_scene(double thickness_mm = 30.0, double max_angle_deg = 100.0) {
   s.roles.source = RoleSource::Auto;
   s.roles.auto_wall_thickness_mm = thickness_mm;
   s.roles.auto_wall_max_angle_deg = max_angle_deg;
+  // The rules on the grid as it is: auto padding (roles/auto_pad.h) has its own tests.
+  s.roles.pad_anterior_mm = 0.0;
+  s.roles.pad_lateral_mm = 0.0;
   return s;
 }
 

@@ -7,10 +7,6 @@
 
 namespace pneumo {
 
-PadMm pad_mm_of(const RoleRules& r) {
-  return {r.pad_anterior_mm, r.pad_lateral_mm, r.pad_superior_mm, r.pad_inferior_mm};
-}
-
 namespace {
 int64_t voxels_for(double mm, double spacing_mm) {
   // The small slack keeps 60 mm at 3 mm spacing at exactly 20 voxels despite rounding.

@@ -13,12 +13,9 @@
 
 namespace pneumo {
 
-struct RoleRules;
-
 struct PadMm {
   double anterior = 0.0, lateral = 0.0, superior = 0.0, inferior = 0.0;
 };
-PadMm pad_mm_of(const RoleRules& roles);
 
 /// Voxels added before index 0 (lo) and after the last index (hi) of each voxel axis.
 struct PadVoxels {

@@ -2,6 +2,7 @@
 // How voxels become roles (method.md §2): the scene's "roles" section. By label lists, or by the
 // automatic HU rules (auto_roles.h) with their thresholds, and the air padded around the CT (pad.h).
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,8 +34,10 @@ struct RoleRules {
   // column becomes wall, so no gas opens there (auto_roles.h, rule 5b), and in the slices from
   // their top down, undecided tissue anterior to their back (rule 6b: below the reflection).
   std::vector<int> auto_prevesical_labels;
-  // Air added around the CT so the wall has room to rise (a 12 mmHg abdomen rises 30-60 mm).
-  double pad_anterior_mm = 0.0, pad_lateral_mm = 0.0, pad_superior_mm = 0.0, pad_inferior_mm = 0.0;
+  // Air added around the CT so the wall has room to rise (a 12 mmHg abdomen rises 30-60 mm). Unset in
+  // front and at the sides: found on the CT (roles/auto_pad.h).
+  std::optional<double> pad_anterior_mm, pad_lateral_mm;
+  double pad_superior_mm = 0.0, pad_inferior_mm = 0.0;
 
   /// Role of every label id 0..65535 (index = id): the role lists, else unlisted_label_role.
   std::vector<Role> label_roles() const;

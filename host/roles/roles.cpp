@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "io/volume_io.h"
+#include "roles/auto_pad.h"
 #include "roles/auto_roles.h"
 #include "roles/label_map.h"
 
@@ -121,7 +122,12 @@ RoleVolume assign_roles(const RoleRules& rules, const Volume& ct, const Volume* 
     check_label_values(*labels, names.labels);
   }
   RoleVolume rv;
-  rv.pad = pad_voxels(ct.geometry(), pad_mm_of(rules));
+  rv.pad = pad_voxels(ct.geometry(), [&] {
+    if ((rules.pad_anterior_mm && rules.pad_lateral_mm) || rules.source != RoleSource::Auto)
+      return resolved_pad_mm(rules, nullptr, ct.geometry());
+    const Volume hu = padded_ct_float(ct, PadVoxels{});   // the HU as floats, freed before the padded copy
+    return resolved_pad_mm(rules, hu.data<float>(), ct.geometry());
+  }());
   rv.geometry = padded_geometry(ct.geometry(), rv.pad);
   rv.ct = padded_ct_float(ct, rv.pad);
   rv.label = padded_labels(labels, ct.geometry(), rv.pad);

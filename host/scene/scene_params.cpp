@@ -136,9 +136,11 @@ const Table<RoleRules>& roles_table() {
        "viscera_labels lies in front of the bladder in a column, the wall starts in front of that organ: "
        "the peritoneum lies in front of the bladder there. TotalSegmentator: [21]."},
       {"pad_anterior_mm", &RoleRules::pad_anterior_mm, "mm", pad,
-       "Air added in front of the CT so the wall has room to rise (a real CT cropped at the skin needs >= 60)."},
+       "Air added in front of the CT so the wall has room to rise. Unset: 60 mm where the body comes closer than "
+       "that to the CT's front edge (a CT cropped at the skin), none otherwise (roles/auto_pad.h). source \"labels\": unset is 0."},
       {"pad_lateral_mm", &RoleRules::pad_lateral_mm, "mm", pad,
-       "Air added on the left and on the right (>= 60 for a CT cropped at the skin)."},
+       "Air added on the left and on the right. Unset: 60 mm on both where the body comes closer than that to "
+       "either side's edge, none otherwise. source \"labels\": unset is 0."},
       {"pad_superior_mm", &RoleRules::pad_superior_mm, "mm", pad, "Air added above the CT (head side)."},
       {"pad_inferior_mm", &RoleRules::pad_inferior_mm, "mm", pad, "Air added below the CT (feet side)."},
   };
