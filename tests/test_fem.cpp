@@ -337,6 +337,57 @@ TEST(FemField, PatchTestReproducesAUniformStrainExactly) {
     }
 }
 
+TEST(FemField, PatchTestHoldsOnCubesOfPerAxisVoxels) {
+  // The patch test above on a lattice whose cubes count different voxels per axis (core/cube_voxels.h):
+  // 2.5 × 2.5 × 5 mm voxels in cubes of 2 × 2 × 1, so 5 mm cubes, 4 per axis, the boundary held at
+  // x = A x₀ and the interior started off it at random. Compared on the CPU: interior positions against
+  // A x₀, tolerance 1e-9 m as above (residual 1e-10). A lattice placed by one L on every axis, or sample
+  // points of the wrong cube size, would still fail it by the random start's 0.3 mm.
+  std::mt19937 rng(kSeed + 16);
+  Geometry g;
+  g.dims = {8, 8, 4};
+  g.spacing_mm = Vec3(2.5, 2.5, 5.0);
+  std::vector<Role> roles(g.voxel_count(), Role::Wall);
+  MeshOptions mo;
+  mo.cube_voxels = CubeVoxels(2, 2, 1);
+  mo.model = MeshModel::Wall;
+  Mesh m = build_mesh(VoxelRoles{g, roles.data(), nullptr}, mo, [](Role, int) { return 60e3; });
+  assign_material(m, MaterialOptions{});
+  m.tet_poisson.assign(m.tets.size(), 0.45);
+  ASSERT_EQ(m.cubes, (std::array<int64_t, 3>{4, 4, 4}));
+  const Mat3 A = rotation(Vec3(1, 0, 1), 0.2) * (Mat3::Identity() + random_matrix(rng, 0.05));
+  Vec3 lo = Vec3::Constant(1e9), hi = Vec3::Constant(-1e9);
+  for (const Vec3& p : m.rest_m) { lo = lo.cwiseMin(p); hi = hi.cwiseMax(p); }
+  EXPECT_NEAR((hi - lo).minCoeff(), 20e-3, 1e-12);
+  EXPECT_NEAR((hi - lo).maxCoeff(), 20e-3, 1e-12);
+  std::vector<Vec3> start(m.node_count());
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int interior = 0;
+  for (int64_t n = 0; n < m.node_count(); ++n) {
+    const Vec3& p = m.rest_m[n];
+    const bool boundary = ((p - lo).cwiseAbs().minCoeff() < 1e-9) || ((hi - p).cwiseAbs().minCoeff() < 1e-9);
+    m.hold[n] = boundary ? kHoldAll : 0;
+    start[n] = A * p + (boundary ? Vec3::Zero() : Vec3(0.3e-3 * Vec3(u(rng), u(rng), u(rng))));
+    interior += !boundary;
+  }
+  ASSERT_EQ(interior, 27);
+  Progress::set_enabled(false);
+  for (const FieldCase& c : kFields) {
+    if (c.model == MaterialModel::Msd) continue;
+    SCOPED_TRACE(c.name);
+    SolveOptions o;
+    o.method = SolverMethod::Newton;
+    o.forces = elastic_only(c);
+    o.residual_tolerance = 1e-10;
+    o.progress = false;
+    const SolveResult r = solve_on_device(nullptr, m, o, start);
+    EXPECT_TRUE(r.converged) << r.stop_reason << ", residual " << r.residual;
+    double worst = 0.0;
+    for (int64_t n = 0; n < m.node_count(); ++n) worst = std::max(worst, (r.x[n] - A * m.rest_m[n]).norm());
+    EXPECT_LT(worst, 1e-9);
+  }
+}
+
 TEST(FireMasses, BoundEveryModeOfTheStiffnessAtRest) {
   // FIRE's step control assumes ω² ≤ 2 for its fictitious masses (solve_static_fire.cpp). Compared:
   // the largest eigenvalue of M^-1/2 K M^-1/2 at rest, by 300 power iterations (the block in its

@@ -52,7 +52,7 @@ RandomCase random_case(std::mt19937& rng) {
   const Mat3 Q = Eigen::AngleAxisd(u(rng), axis).toRotationMatrix();
   Vec3 centre = Vec3::Zero();
   for (const Vec3& r : c.mesh.rest_m) centre += r / double(c.mesh.node_count());
-  const double h = 1e-3 * g.spacing_mm.minCoeff() * mo.cube_voxels;
+  const double h = 1e-3 * g.spacing_mm.minCoeff() * mo.cube_voxels.min();
   for (const Vec3& r : c.mesh.rest_m) {
     c.x.push_back(centre + Q * (r - centre) + 0.1 * h * Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5));
     c.dir.push_back(h * Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5));

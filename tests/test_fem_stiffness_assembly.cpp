@@ -39,7 +39,7 @@ RandomState random_state(std::mt19937& rng) {
   assign_material(s.mesh, MaterialOptions{});
   s.mesh.tet_poisson.resize(s.mesh.tets.size());
   for (auto& nu : s.mesh.tet_poisson) nu = 0.2 + 0.29 * u(rng);
-  const double h = 1e-3 * vox.grid.spacing_mm.minCoeff() * vox.options.cube_voxels;
+  const double h = 1e-3 * vox.grid.spacing_mm.minCoeff() * vox.options.cube_voxels.min();
   auto state = [&] {
     const Mat3 Q = Eigen::AngleAxisd(u(rng), Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5).normalized()).toRotationMatrix();
     std::vector<Vec3> x;

@@ -24,7 +24,7 @@ TEST(TetField, LinearFieldsAreReadExactlyInsideAndBeyondTheMesh) {
     vox.grid.spacing_mm = Vec3::Constant(vox.grid.spacing_mm[0]);   // cubes: isotropic spacing
     const Mesh m = build_mesh(vox.view(), vox.options, [](Role, int) { return 10e3; });
     ASSERT_GT(m.tets.size(), 0u);
-    const double cube_m = 1e-3 * vox.grid.spacing_mm[0] * vox.options.cube_voxels;
+    const double cube_m = 1e-3 * vox.grid.spacing_mm[0] * vox.options.cube_voxels[0];
     Mat3 A;
     A << 0.1, -0.2, 0.3, 0.05, 0.4, -0.1, -0.3, 0.2, 0.15;
     const Vec3 c(1e-3, -2e-3, 5e-4);

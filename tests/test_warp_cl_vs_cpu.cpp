@@ -2,7 +2,7 @@
 // reference), on every OpenCL device found.
 //  - Identity and whole-voxel translation: bit for bit (both are exact by construction: equal
 //    displacements cancel, whole-number sources sample voxels with weights 1 and 0).
-//  - A smooth random deformation, seeded, at two cube sizes, with wall and viscera separating and
+//  - A smooth random deformation, seeded, at two cube sizes and two of per-axis voxel counts, with wall and viscera separating and
 //    pressing into each other (their tetrahedra overlap), in every layout of the sample pass: CT within 0.1 HU where
 //    both carry the voxel (float32 source points are off by ~1e-5 voxel; the random CT changes by up
 //    to 2500 HU per voxel, so 0.03 HU; 0.1 leaves room and is 1/10 of the CT's own quantisation);
@@ -75,7 +75,7 @@ TEST_P(WarpClVsCpu, AffineMatchesAnalyticResamplingWithNoCracks) {
 TEST_P(WarpClVsCpu, RandomDeformationEqualsTheReferenceExceptAtMeasuredTies) {
   struct Trial {
     uint32_t seed;
-    int cube;
+    CubeVoxels cube;
     double toward;   // > 0: wall and viscera press into each other, so tetrahedra of both meshes
                      // overlap and "the lowest accepting index wins" must agree between the
                      // device's atomics and the reference's owners
@@ -83,9 +83,12 @@ TEST_P(WarpClVsCpu, RandomDeformationEqualsTheReferenceExceptAtMeasuredTies) {
                              // cubes against the index order (as the peers' mesh, numbered pattern by
                              // pattern, makes it), so its owners, not its visiting order, must decide
   };
+  // {4, 4, 2} and {3, 4, 2}: per-axis cube voxels (core/cube_voxels.h) on the grid's 0.8 × 0.8 × 1.6 mm voxels,
+  // where the device's cube_of table differs per axis.
   for (const Trial trial : {Trial{31, 4, 0.0}, Trial{32, 4, 0.0}, Trial{33, 3, 0.0}, Trial{34, 4, 1.6},
-                            Trial{35, 3, 1.6}, Trial{36, 4, 1.6, true}}) {
-    SCOPED_TRACE("seed " + std::to_string(trial.seed) + ", cube " + std::to_string(trial.cube) + ", toward " +
+                            Trial{35, 3, 1.6}, Trial{36, 4, 1.6, true}, Trial{37, {4, 4, 2}, 0.0},
+                            Trial{38, {3, 4, 2}, 1.6, true}}) {
+    SCOPED_TRACE("seed " + std::to_string(trial.seed) + ", cube " + trial.cube.text() + ", toward " +
                  std::to_string(trial.toward));
     const WarpCase c = make_warp_case(test_grid(), trial.cube, trial.seed);
     const WarpMesh m = random_warp_mesh(c, trial.seed, trial.toward, trial.reversed);

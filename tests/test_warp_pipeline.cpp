@@ -325,6 +325,6 @@ TEST_F(WarpPipeline, ZeroDeformationWritesTheInputBackBitForBit) {
   const double width_mm = double(roles.geometry.dims[0]) * roles.geometry.spacing_mm[0];
   EXPECT_GT(m.outside_grid_mm, 1000.0 - width_mm - kMaxGridGrowthMm);
   EXPECT_LE(double(m.output_grid.dims[0]) * m.output_grid.spacing_mm[0], width_mm + kMaxGridGrowthMm);
-  EXPECT_GT(double(m.output_grid.dims[0] + m.warp_mesh.cube_voxels) * m.output_grid.spacing_mm[0],
+  EXPECT_GT(double(m.output_grid.dims[0] + m.warp_mesh.cube_voxels[0]) * m.output_grid.spacing_mm[0],
             width_mm + kMaxGridGrowthMm);   // the cap, less under a cube on a low-index side
 }

@@ -64,12 +64,15 @@ TEST_F(WarpReference, TheFastCpuWarpEqualsItOnAWholeVoxelTranslationBitForBit) {
 TEST_F(WarpReference, TheFastCpuWarpEqualsItOnRandomDeformationsExceptAtMeasuredTies) {
   struct Trial {
     uint32_t seed;
-    int cube;
+    CubeVoxels cube;
     double toward;          // > 0: wall and viscera press into each other (overlapping tetrahedra)
     bool reversed = false;  // tetrahedra numbered last cube first: owners, not visiting order, decide
   };
-  for (const Trial trial : {Trial{51, 4, 0.0}, Trial{52, 3, 0.0}, Trial{53, 4, 1.6}, Trial{54, 3, 1.6, true}}) {
-    SCOPED_TRACE("seed " + std::to_string(trial.seed));
+  // {4, 4, 2} and {3, 4, 2}: cubes of per-axis voxel counts, near-cubic on the grid's 0.8 × 0.8 × 1.6 mm voxels
+  // (core/cube_voxels.h), and one lopsided.
+  for (const Trial trial : {Trial{51, 4, 0.0}, Trial{52, 3, 0.0}, Trial{53, 4, 1.6}, Trial{54, 3, 1.6, true},
+                            Trial{55, {4, 4, 2}, 0.0}, Trial{56, {3, 4, 2}, 1.6, true}}) {
+    SCOPED_TRACE("seed " + std::to_string(trial.seed) + ", cube " + trial.cube.text());
     const WarpCase c = make_warp_case(oblique_grid(), trial.cube, trial.seed);
     const WarpMesh m = random_warp_mesh(c, trial.seed, trial.toward, trial.reversed);
     const WarpBox box{{1, 2, 1}, {22, 21, 18}};   // like a CT inside its padding

@@ -37,8 +37,8 @@ struct WarpCase {
 // Label ids by role (the cavity label of the tests, 250, is none of them).
 constexpr uint16_t kWallLabel = 10, kOrganA = 20, kOrganB = 21, kFixedLabel = 30;
 
-/// dims should be multiples of `cube` so that every meshed cube lies inside the grid.
-inline WarpCase make_warp_case(const Geometry& grid, int cube, uint32_t seed) {
+/// dims should be multiples of `cube` (per axis) so that every meshed cube lies inside the grid.
+inline WarpCase make_warp_case(const Geometry& grid, const CubeVoxels& cube, uint32_t seed) {
   WarpCase c;
   c.grid = grid;
   const Index3 d = grid.dims;
@@ -103,7 +103,7 @@ inline std::vector<uint8_t> cube_parts(const Mesh& m) {
 inline uint8_t parts_at(const Mesh& m, const std::vector<uint8_t>& parts, const Vec3& p) {
   int64_t q[3];
   for (int a = 0; a < 3; ++a) {
-    const double f = std::floor((p[a] + 0.5) / m.cube_voxels);
+    const double f = std::floor((p[a] + 0.5) / m.cube_voxels[a]);
     if (!(f >= 0 && f < double(m.cubes[a]))) return 0;
     q[a] = int64_t(f);
   }

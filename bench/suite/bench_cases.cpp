@@ -34,7 +34,7 @@ void build_roles_and_mesh(BenchCase& c) {
 
 }  // namespace
 
-void remesh(BenchCase& c, int cube_voxels) {
+void remesh(BenchCase& c, const CubeVoxels& cube_voxels) {
   QuietLog quiet;
   c.scene.mesh.cube_voxels = cube_voxels;
   c.scene.mesh.cube_mm.reset();   // L in voxels here, whatever the scene said

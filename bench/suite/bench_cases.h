@@ -31,7 +31,7 @@ struct BenchCase {
 /// the scene's L. Logging is quieted while the phantom's scene names labels its CT lacks.
 BenchCase phantom_case(PhantomSize size, int cube_voxels = 0);
 /// Reuses a case's phantom and roles (they do not depend on L) for another cube size.
-void remesh(BenchCase& c, int cube_voxels);
+void remesh(BenchCase& c, const CubeVoxels& cube_voxels);
 /// The real CT of a scene file; nullopt (and `why` says why) when the scene or its CT cannot be read.
 std::optional<BenchCase> scene_case(const std::string& scene_path, const std::string& name, std::string& why);
 

@@ -182,7 +182,8 @@ json measure_case_throughput(BenchContext& ctx, const BenchCase& c, int pipeline
   out["case"] = c.name;
   out["grid"] = {g.dims[0], g.dims[1], g.dims[2]};
   out["spacing_mm"] = {g.spacing_mm.x(), g.spacing_mm.y(), g.spacing_mm.z()};
-  out["cube_voxels"] = c.mesh.cube_voxels;
+  const CubeVoxels& cube = c.mesh.cube_voxels;
+  out["cube_voxels"] = cube.uniform() ? json(cube[0]) : json::array({cube[0], cube[1], cube[2]});
   out["nodes"] = st.nodes;
   out["springs"] = st.springs;
   out["tetrahedra"] = st.tetrahedra;

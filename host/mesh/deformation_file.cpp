@@ -19,7 +19,6 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "deformation.bin is wri
 namespace {
 
 constexpr char kMagic[8] = {'P', 'N', 'E', 'U', 'M', 'O', 'D', 'F'};
-constexpr uint32_t kVersion = 1;
 constexpr uint32_t kHeaderBytes = 64;
 
 struct Header {
@@ -48,9 +47,14 @@ uint64_t payload_checksum(const std::vector<Vec3>& u) {
 
 }  // namespace
 
-uint64_t mesh_fingerprint(const Mesh& mesh) {
+uint64_t mesh_fingerprint(const Mesh& mesh, uint32_t version) {
   Fnv1a f;
-  f.add(int32_t(mesh.cube_voxels));
+  if (version == 1) {
+    if (!mesh.cube_voxels.uniform()) return 0;
+    f.add(int32_t(mesh.cube_voxels[0]));
+  } else {
+    for (int a = 0; a < 3; ++a) f.add(int32_t(mesh.cube_voxels[a]));
+  }
   f.add(uint64_t(mesh.node_count()));
   for (const Vec3& x : mesh.rest_m) f.add(x.data(), 3 * sizeof(double));
   f.add(mesh.node_part.data(), mesh.node_part.size() * sizeof(Part));
@@ -67,7 +71,7 @@ void write_deformation(const std::string& path, const Mesh& mesh, const Deformat
   check_writable_target(path);
   Header h{};
   std::memcpy(h.magic, kMagic, sizeof kMagic);
-  h.version = kVersion;
+  h.version = kDeformationFileVersion;
   h.header_bytes = kHeaderBytes;
   h.nodes = uint64_t(mesh.node_count());
   h.tets = uint64_t(mesh.tets.size());
@@ -96,11 +100,14 @@ Deformation read_deformation(const std::string& path, const Mesh& mesh) {
   Header h{};
   if (std::fread(&h, 1, sizeof h, is) != sizeof h || std::memcmp(h.magic, kMagic, sizeof kMagic) != 0)
     throw file_error(path, "not a pneumo deformation file");
-  if (h.version != kVersion || h.header_bytes != kHeaderBytes)
-    throw file_error(path, "deformation file version " + std::to_string(h.version) + ", this pneumo reads version " +
-                               std::to_string(kVersion));
-  if (h.nodes != uint64_t(mesh.node_count()) || h.tets != uint64_t(mesh.tets.size()) ||
-      h.fingerprint != mesh_fingerprint(mesh))
+  // Version 1 differs only in its fingerprint (one L for all axes): still read.
+  if ((h.version != 1 && h.version != kDeformationFileVersion) || h.header_bytes != kHeaderBytes)
+    throw file_error(path, "deformation file version " + std::to_string(h.version) + ", this pneumo reads versions 1 and " +
+                               std::to_string(kDeformationFileVersion));
+  // A version 1 file was written for a mesh of one L: never for one whose axes differ.
+  const bool same_mesh = h.version == 1 ? mesh.cube_voxels.uniform() && h.fingerprint == mesh_fingerprint(mesh, 1)
+                                        : h.fingerprint == mesh_fingerprint(mesh);
+  if (h.nodes != uint64_t(mesh.node_count()) || h.tets != uint64_t(mesh.tets.size()) || !same_mesh)
     throw file_error(path, "written for another mesh (" + std::to_string(h.nodes) + " nodes, " +
                                std::to_string(h.tets) + " tetrahedra; the scene now gives " +
                                std::to_string(mesh.node_count()) + " nodes, " + std::to_string(mesh.tets.size()) +

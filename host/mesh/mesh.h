@@ -1,5 +1,5 @@
 #pragma once
-// The mass-spring-damper mesh (method.md §3–4): nodes at cube corners of an L×L×L-voxel grid, 5
+// The mass-spring-damper mesh (method.md §3–4): nodes at cube corners of an L₀×L₁×L₂-voxel grid, 5
 // tetrahedra per cube, springs and dampers on every tetrahedron edge, separate wall and viscera
 // meshes (doubled where they touch), fixed nodes and the gas pressure's load.
 //
@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "core/cube_voxels.h"
 #include "core/geometry.h"
 #include "domain/types.h"
 
@@ -52,7 +53,7 @@ using VoxelYoungFn = std::function<double(Role, int label, float hu)>;
 inline constexpr double kMinTissueFraction = 1e-2;
 
 struct MeshOptions {
-  int cube_voxels = 8;                     // L
+  CubeVoxels cube_voxels{8};               // L per grid axis (core/cube_voxels.h)
   MeshModel model = MeshModel::WallViscera;
   std::optional<Vec3> roi_min_mm, roi_max_mm;   // cubes whose centre lies outside are not meshed
   /// What the caller will allocate per node and per tetrahedron once the mesh exists (a solver's
@@ -148,7 +149,7 @@ struct Mesh {
 
   // Where it came from.
   Geometry grid;                            // the voxel grid
-  int cube_voxels = 0;
+  CubeVoxels cube_voxels{0};                // L per grid axis
   std::array<int64_t, 3> cubes{0, 0, 0};    // cubes per axis
   MeshStats stats;
 

@@ -37,9 +37,13 @@ struct Lattice {
   }
 };
 
-/// Sample points per voxel and axis: at least 4 per cube edge, so that even with 1-voxel cubes each
-/// corner tetrahedron (a sixth of the cube) holds several. With s·L samples along an edge at
-/// (m + ½)/(s·L), no sample lies on a tetrahedron's face (Σ|u − o| is never exactly 1).
+/// Sample points per voxel along an axis of L voxels per cube: at least 4 per cube edge, so that even
+/// with 1-voxel cubes each corner tetrahedron (a sixth of the cube) holds several. With N_a = s_a·L_a
+/// samples along axis a at u_a = (2m + 1)/(2N_a), Σ|u − o| = 1 needs Σ (2m_a + 1)·D/(2N_a) = D for
+/// D = lcm(2N_a): when every N_a holds the same power of 2 (an isotropic lattice, or (12, 12, 4)) the
+/// left side is a sum of three odd numbers and D is even, so no sample lies on a tetrahedron's face.
+/// Otherwise a few may, and tet_holding gives each to one tetrahedron (rounding decides which) the same
+/// way in every cube of its pattern and in that pattern's per_tet, so a full tetrahedron still counts as full.
 int samples_per_voxel(int L) { return std::max(1, (4 + L - 1) / L); }
 
 /// Per cube: which roles its voxels hold, each part's dominant label, and per part and tetrahedron
@@ -54,32 +58,38 @@ struct CubeContent {
 };
 
 /// Which tetrahedron holds each sample point of a cube, for both patterns: the same in every cube, so
-/// found once per mesh, not for each of 10⁸ voxels. Entry ((z·L + y)·L + x)·s³ + (mz·s + my)·s + mx:
-/// voxel (x,y,z) of the cube, its sample (mx,my,mz) at ((x + (mx + ½)/s) / L, …).
+/// found once per mesh, not for each of 10⁸ voxels. Entry ((z·L₁ + y)·L₀ + x)·s³ + (mz·s₁ + my)·s₀ + mx
+/// (s³ = s₀s₁s₂): voxel (x,y,z) of the cube, its sample (mx,my,mz) at ((x + (mx + ½)/s₀) / L₀, …).
 struct SampleTets {
-  int L = 1, s = 1, s3 = 1;
+  CubeVoxels L{1};
+  std::array<int, 3> s{1, 1, 1};
+  int s3 = 1;
   std::vector<uint8_t> tet_of[2];   // [odd pattern]
 
-  explicit SampleTets(int cube_voxels) : L(cube_voxels), s(samples_per_voxel(cube_voxels)), s3(s * s * s) {
+  explicit SampleTets(const CubeVoxels& cube)
+      : L(cube), s{samples_per_voxel(cube[0]), samples_per_voxel(cube[1]), samples_per_voxel(cube[2])},
+        s3(s[0] * s[1] * s[2]) {
     for (int odd = 0; odd < 2; ++odd) {
-      tet_of[odd].resize(std::size_t(L) * L * L * s3);
-      for (int z = 0; z < L; ++z)
-        for (int y = 0; y < L; ++y)
-          for (int x = 0; x < L; ++x)
-            for (int mz = 0; mz < s; ++mz)
-              for (int my = 0; my < s; ++my)
-                for (int mx = 0; mx < s; ++mx) {
-                  const std::array<double, 3> u{(double(x) + (mx + 0.5) / s) / L, (double(y) + (my + 0.5) / s) / L,
-                                                (double(z) + (mz + 0.5) / s) / L};
-                  tet_of[odd][std::size_t(((z * L + y) * L + x) * s3 + (mz * s + my) * s + mx)] =
+      tet_of[odd].resize(std::size_t(L.volume()) * s3);
+      for (int z = 0; z < L[2]; ++z)
+        for (int y = 0; y < L[1]; ++y)
+          for (int x = 0; x < L[0]; ++x)
+            for (int mz = 0; mz < s[2]; ++mz)
+              for (int my = 0; my < s[1]; ++my)
+                for (int mx = 0; mx < s[0]; ++mx) {
+                  const std::array<double, 3> u{(double(x) + (mx + 0.5) / s[0]) / L[0],
+                                                (double(y) + (my + 0.5) / s[1]) / L[1],
+                                                (double(z) + (mz + 0.5) / s[2]) / L[2]};
+                  tet_of[odd][std::size_t(((z * L[1] + y) * L[0] + x) * s3 + (mz * s[1] + my) * s[0] + mx)] =
                       uint8_t(lattice::tet_holding(u, odd != 0));
                 }
     }
   }
-  /// The sample points of a whole cube in each tetrahedron (the same for both patterns, by symmetry).
-  std::array<int64_t, 5> per_tet() const {
+  /// The sample points of a whole cube of pattern `odd` in each tetrahedron: the same for both patterns
+  /// by symmetry where no sample lies on a face, counted per pattern for the samples rounding decides.
+  std::array<int64_t, 5> per_tet(int odd) const {
     std::array<int64_t, 5> count{};
-    for (uint8_t t : tet_of[0]) ++count[t];
+    for (uint8_t t : tet_of[odd]) ++count[t];
     return count;
   }
 };
@@ -87,7 +97,8 @@ struct SampleTets {
 std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& lat, const SampleTets& samples,
                                         const VoxelYoungFn& young_pa_for) {
   const Geometry& g = roles.geometry;
-  const int L = samples.L, s3 = samples.s3;
+  const CubeVoxels& L = samples.L;
+  const int s3 = samples.s3;
   const std::vector<uint8_t>(&tet_of)[2] = samples.tet_of;
   std::vector<CubeContent> out(lat.cubes[0] * lat.cubes[1] * lat.cubes[2]);
 #pragma omp parallel
@@ -101,9 +112,9 @@ std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& 
           CubeContent cc;
           const int odd = ((a + b + c) & 1) != 0;
           for (auto& n : counts) n.clear();
-          for (int64_t k = c * L; k < std::min<int64_t>((c + 1) * L, g.dims[2]); ++k)
-            for (int64_t j = b * L; j < std::min<int64_t>((b + 1) * L, g.dims[1]); ++j)
-              for (int64_t i = a * L; i < std::min<int64_t>((a + 1) * L, g.dims[0]); ++i) {
+          for (int64_t k = c * L[2]; k < std::min<int64_t>((c + 1) * L[2], g.dims[2]); ++k)
+            for (int64_t j = b * L[1]; j < std::min<int64_t>((b + 1) * L[1], g.dims[1]); ++j)
+              for (int64_t i = a * L[0]; i < std::min<int64_t>((a + 1) * L[0], g.dims[0]); ++i) {
                 const int64_t v = g.linear_index(i, j, k);
                 const Role r = roles.role[v];
                 cc.has[static_cast<int>(r)] = true;
@@ -114,7 +125,8 @@ std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& 
                 if (hit == counts[p].end()) counts[p].emplace_back(id, 1);
                 else ++hit->second;
                 const double young = young_pa_for(r, id, roles.hu ? roles.hu[v] : 0.0f), compliance = 1.0 / young;
-                const uint8_t* tet = tet_of[odd].data() + ((((k - c * L) * L + (j - b * L)) * L + (i - a * L)) * s3);
+                const uint8_t* tet =
+                    tet_of[odd].data() + ((((k - c * L[2]) * L[1] + (j - b * L[1])) * L[0] + (i - a * L[0])) * s3);
                 for (int m = 0; m < s3; ++m) {
                   ++cc.tissue[p][tet[m]];
                   cc.young_sum[p][tet[m]] += young;
@@ -147,18 +159,18 @@ double hill_modulus(double young_sum, double compliance_sum, int64_t n) {
   return 0.5 * (young_sum / double(n) + double(n) / compliance_sum);
 }
 
-/// Rest position of lattice node (a,b,c): the corner of voxel (aL, bL, cL) at index aL − ½.
-Vec3 node_world_m(const Geometry& g, int64_t a, int64_t b, int64_t c, int L) {
-  const Vec3 idx(double(a * L) - 0.5, double(b * L) - 0.5, double(c * L) - 0.5);
+/// Rest position of lattice node (a,b,c): the corner of voxel (aL₀, bL₁, cL₂) at index aL₀ − ½.
+Vec3 node_world_m(const Geometry& g, int64_t a, int64_t b, int64_t c, const CubeVoxels& L) {
+  const Vec3 idx(double(a * L[0]) - 0.5, double(b * L[1]) - 0.5, double(c * L[2]) - 0.5);
   return g.to_world(idx) * units::kMetresPerMm;
 }
 
 /// Whether a fixed voxel touches the lattice node (a,b,c): one of the 8 voxels sharing its corner.
-bool touches_fixed(const VoxelRoles& roles, int64_t a, int64_t b, int64_t c, int L) {
+bool touches_fixed(const VoxelRoles& roles, int64_t a, int64_t b, int64_t c, const CubeVoxels& L) {
   const Geometry& g = roles.geometry;
-  for (int64_t k = c * L - 1; k <= c * L; ++k)
-    for (int64_t j = b * L - 1; j <= b * L; ++j)
-      for (int64_t i = a * L - 1; i <= a * L; ++i) {
+  for (int64_t k = c * L[2] - 1; k <= c * L[2]; ++k)
+    for (int64_t j = b * L[1] - 1; j <= b * L[1]; ++j)
+      for (int64_t i = a * L[0] - 1; i <= a * L[0]; ++i) {
         if (i < 0 || j < 0 || k < 0 || i >= g.dims[0] || j >= g.dims[1] || k >= g.dims[2]) continue;
         if (roles.role[g.linear_index(i, j, k)] == Role::Fixed) return true;
       }
@@ -197,9 +209,9 @@ std::array<double, 4> rest_barycentric(const Mesh& m, int32_t t, const Vec3& x_m
 }
 
 /// Cube (a,b,c)'s local coordinates u ∈ [0,1]³ of a point given in voxel index space.
-std::array<double, 3> cube_local(const Vec3& index, int64_t a, int64_t b, int64_t c, int L) {
-  return {(index[0] + 0.5 - double(a * L)) / L, (index[1] + 0.5 - double(b * L)) / L,
-          (index[2] + 0.5 - double(c * L)) / L};
+std::array<double, 3> cube_local(const Vec3& index, int64_t a, int64_t b, int64_t c, const CubeVoxels& L) {
+  return {(index[0] + 0.5 - double(a * L[0])) / L[0], (index[1] + 0.5 - double(b * L[1])) / L[1],
+          (index[2] + 0.5 - double(c * L[2])) / L[2]};
 }
 
 /// The wall labels of MeshOptions::attached_labels, looked up per voxel.
@@ -213,13 +225,13 @@ struct AttachedLabels {
 /// Marks the nodes of attached interfaces (Mesh::node_attached): for every face between a wall voxel
 /// of an attached label and a viscera voxel, the corners of the wall voxel's cube in the wall's mesh
 /// and of the viscera voxel's cube in the viscera's. Counts those faces, both sides, as the cavity's.
-void mark_attached_nodes(Mesh& m, const VoxelRoles& roles, int L, const std::vector<int32_t> (&node_id)[kParts],
+void mark_attached_nodes(Mesh& m, const VoxelRoles& roles, const CubeVoxels& L, const std::vector<int32_t> (&node_id)[kParts],
                          const Lattice& lat, const AttachedLabels& attached) {
   m.node_attached.assign(std::size_t(m.node_count()), 0);
   if (attached.ids.empty()) return;
   const Geometry& g = roles.geometry;
   auto mark_cube = [&](int p, int64_t i, int64_t j, int64_t k) {
-    const int64_t a = i / L, b = j / L, c = k / L;
+    const int64_t a = i / L[0], b = j / L[1], c = k / L[2];
     for (int corner = 0; corner < 8; ++corner) {
       const auto o = lattice::corner_offset(corner);
       const int32_t id = node_id[p][lat.node_index(a + o[0], b + o[1], c + o[2])];
@@ -256,7 +268,7 @@ void mark_attached_nodes(Mesh& m, const VoxelRoles& roles, int L, const std::vec
 /// part's role, split into 4 triangles (centre and each edge) so each lies in one tetrahedron face
 /// when L = 1, carried by part p's tetrahedron in the voxel's cube that holds the triangle's centroid.
 /// The same faces make the contact surfaces between wall and viscera (mesh.h).
-void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, int L,
+void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, const CubeVoxels& L,
                           const std::vector<uint8_t>& meshed, const std::vector<int32_t> (&first_tet)[kParts],
                           const AttachedLabels& attached) {
   const Geometry& g = roles.geometry;
@@ -279,9 +291,9 @@ void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
         Accum acc[kParts][5];
         for (int p = 0; p < kParts; ++p)
           for (int k = 0; k < 5; ++k) acc[p][k] = Accum{-1, {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()}, 0};
-        for (int64_t k = c * L; k < std::min<int64_t>((c + 1) * L, g.dims[2]); ++k)
-          for (int64_t j = b * L; j < std::min<int64_t>((b + 1) * L, g.dims[1]); ++j)
-            for (int64_t i = a * L; i < std::min<int64_t>((a + 1) * L, g.dims[0]); ++i) {
+        for (int64_t k = c * L[2]; k < std::min<int64_t>((c + 1) * L[2], g.dims[2]); ++k)
+          for (int64_t j = b * L[1]; j < std::min<int64_t>((b + 1) * L[1], g.dims[1]); ++j)
+            for (int64_t i = a * L[0]; i < std::min<int64_t>((a + 1) * L[0], g.dims[0]); ++i) {
               const Role r = roles.role[g.linear_index(i, j, k)];
               if (r != Role::Wall && r != Role::Viscera) continue;
               const int p = r == Role::Wall ? 0 : 1;
@@ -376,7 +388,7 @@ void build_pressure_loads(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
 /// towards a voxel that is neither fixed nor wall (viscera, or the space between), in a cube the
 /// viscera mesh or next to one. The wall's side of bone is left out: the viscera reach it only through
 /// the wall, whose own faces already stop them.
-void build_bone_obstacles(Mesh& m, const VoxelRoles& roles, const Lattice& lat, int L,
+void build_bone_obstacles(Mesh& m, const VoxelRoles& roles, const Lattice& lat, const CubeVoxels& L,
                           const std::vector<uint8_t>& meshed) {
   const Geometry& g = roles.geometry;
   std::vector<uint8_t> near_viscera(meshed.size(), 0);   // the viscera's cubes dilated by one
@@ -390,7 +402,7 @@ void build_bone_obstacles(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
               if (lat.inside(x, y, z)) near_viscera[lat.cube_index(x, y, z)] = 1;
       }
   auto viscera_cube = [&](int64_t i, int64_t j, int64_t k) {
-    return near_viscera[lat.cube_index(i / L, j / L, k / L)] != 0;
+    return near_viscera[lat.cube_index(i / L[0], j / L[1], k / L[2])] != 0;
   };
   // Slice by slice on every core (10⁸ voxels), joined in slice order: the faces in one pass's order.
   struct Faces { std::vector<Vec3> centre_m, area_m2; };
@@ -421,9 +433,9 @@ void build_bone_obstacles(Mesh& m, const VoxelRoles& roles, const Lattice& lat, 
   }
 }
 
-Lattice lattice_of(const Geometry& g, int L) {
+Lattice lattice_of(const Geometry& g, const CubeVoxels& L) {
   Lattice lat;
-  for (int a = 0; a < 3; ++a) lat.cubes[a] = (g.dims[a] + L - 1) / L;
+  lat.cubes = L.cubes_for(g.dims);
   return lat;
 }
 
@@ -431,18 +443,18 @@ Lattice lattice_of(const Geometry& g, int L) {
 /// cubes whose centre lies in the region of interest.
 std::vector<uint8_t> meshed_parts(const VoxelRoles& roles, const Lattice& lat, const MeshOptions& opt) {
   const Geometry& g = roles.geometry;
-  const int L = opt.cube_voxels;
+  const CubeVoxels& L = opt.cube_voxels;
   const bool with_viscera = opt.model == MeshModel::WallViscera;
   std::vector<uint8_t> meshed(std::size_t(lat.cubes[0] * lat.cubes[1] * lat.cubes[2]), 0);
   // One layer of cubes per iteration: each thread writes only its own layers' cubes.
 #pragma omp parallel for schedule(static)
   for (int64_t c = 0; c < lat.cubes[2]; ++c)
-    for (int64_t k = c * L; k < std::min<int64_t>((c + 1) * L, g.dims[2]); ++k)
+    for (int64_t k = c * L[2]; k < std::min<int64_t>((c + 1) * L[2], g.dims[2]); ++k)
       for (int64_t j = 0; j < g.dims[1]; ++j) {
         const Role* row = roles.role + g.linear_index(0, j, k);
-        uint8_t* cube_row = meshed.data() + lat.cube_index(0, j / L, c);
+        uint8_t* cube_row = meshed.data() + lat.cube_index(0, j / L[1], c);
         for (int64_t a = 0; a < lat.cubes[0]; ++a)
-          for (int64_t i = a * L; i < std::min<int64_t>((a + 1) * L, g.dims[0]); ++i) {
+          for (int64_t i = a * L[0]; i < std::min<int64_t>((a + 1) * L[0], g.dims[0]); ++i) {
             const Role r = row[i];
             if (r == Role::Wall || (with_viscera && r == Role::Viscera)) cube_row[a] |= r == Role::Wall ? 1 : 2;
           }
@@ -451,7 +463,8 @@ std::vector<uint8_t> meshed_parts(const VoxelRoles& roles, const Lattice& lat, c
     for (int64_t c = 0; c < lat.cubes[2]; ++c)
       for (int64_t b = 0; b < lat.cubes[1]; ++b)
         for (int64_t a = 0; a < lat.cubes[0]; ++a) {
-          const Vec3 centre = g.to_world(Vec3((a + 0.5) * L - 0.5, (b + 0.5) * L - 0.5, (c + 0.5) * L - 0.5));
+          const Vec3 centre =
+              g.to_world(Vec3((a + 0.5) * L[0] - 0.5, (b + 0.5) * L[1] - 0.5, (c + 0.5) * L[2] - 0.5));
           if (!(centre.array() >= opt.roi_min_mm->array()).all() || !(centre.array() <= opt.roi_max_mm->array()).all())
             meshed[lat.cube_index(a, b, c)] = 0;
         }
@@ -462,8 +475,8 @@ std::vector<uint8_t> meshed_parts(const VoxelRoles& roles, const Lattice& lat, c
 
 MeshFootprint estimate_mesh_footprint(const VoxelRoles& roles, const MeshOptions& opt) {
   const Geometry& g = roles.geometry;
-  const int L = opt.cube_voxels;
-  if (L < 1) throw InputError("mesh.cube_voxels must be at least 1");
+  const CubeVoxels& L = opt.cube_voxels;
+  if (!L.valid()) throw InputError("mesh.cube_voxels must be at least 1 on every axis");
   const Lattice lat = lattice_of(g, L);
   const std::vector<uint8_t> meshed = meshed_parts(roles, lat, opt);
   MeshFootprint fp;
@@ -536,20 +549,32 @@ void require_mesh_memory(const VoxelRoles& roles, const MeshOptions& opt) {
   const uint64_t need = estimate_mesh_footprint(roles, opt).bytes;
   if (need <= budget.bytes) return;
   // The smallest coarsening that fits (each estimate is two passes over the voxels, well under the
-  // time the refused build would have taken).
+  // time the refused build would have taken): cubes of a growing edge in mm, each axis in whole
+  // voxels of its own spacing (scene/scene_presets.h) and never finer than now, in steps of half the
+  // finest spacing, so an isotropic lattice tries L + 1, L + 2, … as one L did.
   std::string advice = "narrow the region of interest (mesh.roi_min_mm, mesh.roi_max_mm)";
-  for (int L = opt.cube_voxels + 1; L <= 4 * opt.cube_voxels + 4; ++L) {
+  const Vec3& spacing = roles.geometry.spacing_mm;
+  const double edge_mm = opt.cube_voxels.edge_mm(spacing).maxCoeff(), step_mm = 0.5 * spacing.minCoeff();
+  CubeVoxels last = opt.cube_voxels;
+  for (int t = 1;; ++t) {
+    CubeVoxels L = cube_voxels_for_mm(edge_mm + t * step_mm, spacing);
+    for (int a = 0; a < 3; ++a) L[a] = std::max(L[a], opt.cube_voxels[a]);
+    if (L.max() > 4 * opt.cube_voxels.max() + 4) break;
+    if (L == last) continue;
+    last = L;
     MeshOptions coarser = opt;
     coarser.cube_voxels = L;
     const uint64_t b = estimate_mesh_footprint(roles, coarser).bytes;
     if (b > budget.bytes) continue;
     char mm[32];
-    std::snprintf(mm, sizeof mm, "%g", L * roles.geometry.spacing_mm.maxCoeff());
-    advice = "raise mesh.cube_voxels to " + std::to_string(L) + " (mesh.cube_mm " + mm + ", about " + format_bytes(b) +
-             ") or " + advice;
+    std::snprintf(mm, sizeof mm, "%g", L.edge_mm(spacing).maxCoeff());
+    const std::string voxels =
+        L.uniform() ? L.text() : "[" + std::to_string(L[0]) + ", " + std::to_string(L[1]) + ", " + std::to_string(L[2]) + "]";
+    advice = "raise mesh.cube_voxels to " + voxels + " (mesh.cube_mm " + mm + ", about " + format_bytes(b) + ") or " +
+             advice;
     break;
   }
-  require_memory(need, budget, "the mesh of " + std::to_string(opt.cube_voxels) + "-voxel cubes", advice);
+  require_memory(need, budget, "the mesh of " + opt.cube_voxels.text() + "-voxel cubes", advice);
 }
 
 uint64_t mesh_bytes(const Mesh& m) {
@@ -568,14 +593,14 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const std::func
 
 Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoungFn& young_pa_for) {
   const Geometry& g = roles.geometry;
-  const int L = opt.cube_voxels;
-  if (L < 1) throw InputError("mesh.cube_voxels must be at least 1");
+  const CubeVoxels& L = opt.cube_voxels;
+  if (!L.valid()) throw InputError("mesh.cube_voxels must be at least 1 on every axis");
   const Lattice lat = lattice_of(g, L);
   require_mesh_memory(roles, opt);
 
   const SampleTets samples(L);
   const std::vector<CubeContent> content = classify_cubes(roles, lat, samples, young_pa_for);
-  const std::array<int64_t, 5> tet_samples = samples.per_tet();
+  const std::array<int64_t, 5> tet_samples[2] = {samples.per_tet(0), samples.per_tet(1)};
   const bool with_viscera = opt.model == MeshModel::WallViscera;
 
   const std::vector<uint8_t> meshed = meshed_parts(roles, lat, opt);
@@ -628,7 +653,7 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
             double vol = signed_tet_volume(m.rest_m[tet[0]], m.rest_m[tet[1]], m.rest_m[tet[2]], m.rest_m[tet[3]]);
             if (vol < 0) { std::swap(tet[2], tet[3]); vol = -vol; }
             const int64_t tissue = content[q].tissue[p][k];
-            const double total = double(tet_samples[k]);
+            const double total = double(tet_samples[odd][k]);
             m.tets.push_back(tet);
             m.tet_part.push_back(Part(p));
             m.tet_label.push_back(label);
@@ -643,7 +668,7 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
       }
   if (m.tets.empty()) {
     std::ostringstream os;
-    os << "nothing to mesh: no cube of " << L << " voxels holds a wall"
+    os << "nothing to mesh: no cube of " << L.text() << " voxels holds a wall"
        << (with_viscera ? " or viscera" : "") << " voxel" << (opt.roi_min_mm ? " inside the region of interest" : "");
     throw InputError(os.str());
   }

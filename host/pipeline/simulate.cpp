@@ -215,7 +215,9 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   j["stop_reason"] = stop_reason_text(r.stop_reason);
   j["solver"] = r.solver;
   j["pressure_mmhg"] = r.final_pressure_pa / units::kPaPerMmHg;
-  j["cube_voxels"] = sim.mesh.cube_voxels;
+  // As the scene writes it: one integer when every axis agrees.
+  const CubeVoxels& cube = sim.mesh.cube_voxels;
+  j["cube_voxels"] = cube.uniform() ? nlohmann::json(cube[0]) : nlohmann::json::array({cube[0], cube[1], cube[2]});
   j["nodes"] = s.nodes;
   j["tetrahedra"] = s.tetrahedra;
   j["springs"] = s.springs;

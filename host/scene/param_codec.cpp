@@ -173,6 +173,7 @@ std::string ParamInfo::type_text() const {
     case Kind::RealList: return "array of numbers";
     case Kind::Section: return "object";
     case Kind::ObjectArray: return "array of objects";
+    case Kind::CubeVoxels: return "integer or [i, j, k]";
   }
   return "?";
 }
@@ -191,6 +192,7 @@ std::string ParamInfo::expected_text() const {
     case Kind::RealList: s = "an array of numbers"; break;
     case Kind::Section: s = "an object"; break;
     case Kind::ObjectArray: s = "an array of objects"; break;
+    case Kind::CubeVoxels: s = "an integer or an array of 3 integers"; break;
   }
   return optional ? s + " or null" : s;
 }
@@ -215,6 +217,7 @@ std::string ParamInfo::allowed_text() const {
     case Kind::RealList: parts.push_back("each " + c.range.text()); break;
     case Kind::Section: break;
     case Kind::ObjectArray: break;
+    case Kind::CubeVoxels: parts.push_back("each " + c.range.text()); break;
   }
   if (!items().empty()) parts.push_back(items());
   if (c.rule_text) parts.push_back(c.rule_text);
@@ -303,6 +306,17 @@ Vec3 read_vec3(const json& v, const ParamInfo& p, const At& at) {
     if (!x.is_number()) fail_type(v, p, at);
   Vec3 out;
   for (std::size_t i = 0; i < 3; ++i) out[static_cast<int>(i)] = checked_number(v[i], p, at.item(i));
+  return out;
+}
+
+CubeVoxels read_cube_voxels(const json& v, const ParamInfo& p, const At& at) {
+  if (!v.is_array()) return CubeVoxels(static_cast<int>(read_integer(v, p, at)));   // the range keeps it an int
+  if (v.size() != 3) fail_type(v, p, at);
+  for (const json& x : v)
+    if (!x.is_number()) fail_type(v, p, at);
+  const ParamInfo element = element_info(p, Kind::Int);
+  CubeVoxels out;
+  for (std::size_t i = 0; i < 3; ++i) out[static_cast<int>(i)] = static_cast<int>(read_integer(v[i], element, at.item(i)));
   return out;
 }
 

@@ -22,6 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/cube_voxels.h"
 #include "core/geometry.h"
 #include "scene/scene.h"
 
@@ -29,7 +30,7 @@ namespace pneumo::scene_detail {
 
 using json = nlohmann::json;
 
-enum class Kind { Bool, Int, Real, String, Path, Enum, Vec3, IdList, RealList, Section, ObjectArray };
+enum class Kind { Bool, Int, Real, String, Path, Enum, Vec3, IdList, RealList, Section, ObjectArray, CubeVoxels };
 
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
 inline constexpr std::size_t kNoLimit = std::numeric_limits<std::size_t>::max();
@@ -122,6 +123,8 @@ std::size_t read_enum(const json& v, const ParamInfo& p, const At& at);
 Vec3 read_vec3(const json& v, const ParamInfo& p, const At& at);
 std::vector<int> read_id_list(const json& v, const ParamInfo& p, const At& at);
 std::vector<double> read_real_list(const json& v, const ParamInfo& p, const At& at);
+/// One integer for all three axes or [i, j, k], each within the key's range.
+CubeVoxels read_cube_voxels(const json& v, const ParamInfo& p, const At& at);
 /// The array check shared by lists and arrays of objects: type and item count.
 void check_array(const json& v, const ParamInfo& p, const At& at);
 [[noreturn]] void fail_unknown_key(const TableDoc& table, const std::string& key, const At& at);
@@ -159,6 +162,13 @@ template <> struct Value<Vec3> {
   static constexpr Kind kind = Kind::Vec3;
   static Vec3 read(const json& v, const ParamInfo& p, const At& at) { return read_vec3(v, p, at); }
   static json write(const Vec3& x, const ParamInfo&) { return json::array({x[0], x[1], x[2]}); }
+};
+template <> struct Value<CubeVoxels> {
+  static constexpr Kind kind = Kind::CubeVoxels;
+  static CubeVoxels read(const json& v, const ParamInfo& p, const At& at) { return read_cube_voxels(v, p, at); }
+  static json write(const CubeVoxels& x, const ParamInfo&) {   // as written: one integer when all axes agree
+    return x.uniform() ? json(x[0]) : json::array({x[0], x[1], x[2]});
+  }
 };
 template <> struct Value<std::vector<int>> {
   static constexpr Kind kind = Kind::IdList;

@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/cube_voxels.h"
 #include "core/geometry.h"
 #include "domain/types.h"
 #include "render/view_settings.h"
@@ -32,8 +33,8 @@ struct SceneInputs {
 };
 
 struct SceneMesh {
-  int cube_voxels = 8;  // L, Nimura's value (§4 defaults)
-  std::optional<double> cube_mm;  // when set, L from the CT's spacing (cube_voxels_for)
+  CubeVoxels cube_voxels{8};  // L per axis, Nimura's value (§4 defaults) on each
+  std::optional<double> cube_mm;  // when set, L per axis from the CT's spacing (cube_voxels_for)
   MeshModel model = MeshModel::WallViscera;
   std::optional<Vec3> roi_min_mm, roi_max_mm;  // both or neither
   std::vector<int> attached_labels;   // wall labels whose interface with the viscera stays closed

@@ -150,7 +150,9 @@ const Table<RoleRules>& roles_table() {
 const Table<SceneMesh>& mesh_table() {
   static const Table<SceneMesh> t{
       {"cube_voxels", &SceneMesh::cube_voxels, "voxels", in(1, 64),
-       "L: each mesh cube covers L×L×L voxels, split into 5 tetrahedra (§3; Nimura: 8)."},
+       "L: each mesh cube covers L×L×L voxels, split into 5 tetrahedra (§3; Nimura: 8); [i, j, k]: that many voxels "
+       "along each axis of the CT's grid, for near-cubic cubes on anisotropic voxels (e.g. [12, 12, 4] on "
+       "0.75×0.75×2.5 mm). Ignored where cube_mm is set."},
       {"cube_mm", &SceneMesh::cube_mm, "mm", above(0, 1000),
        "Cube edge in mm instead of voxels: L = the whole number of voxels nearest to it along the CT's coarsest "
        "axis (at least 1). Unset: cube_voxels. The presets set it, so they mean the same on any CT."},

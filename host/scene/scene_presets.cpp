@@ -85,9 +85,9 @@ const std::string& preset_reference_text() {
   return text;
 }
 
-int cube_voxels_for(const SceneMesh& mesh, const Geometry& grid) {
+CubeVoxels cube_voxels_for(const SceneMesh& mesh, const Geometry& grid) {
   if (!mesh.cube_mm) return mesh.cube_voxels;
-  return std::max(1, int(std::lround(*mesh.cube_mm / grid.spacing_mm.maxCoeff())));
+  return CubeVoxels(std::max(1, int(std::lround(*mesh.cube_mm / grid.spacing_mm.maxCoeff()))));
 }
 
 }  // namespace pneumo

@@ -81,7 +81,10 @@ class SpatialHash {
 
 ContactSearch::ContactSearch(const Mesh& m, double kappa) : m_(m), kappa_(kappa) {
   const double spacing_m = m.grid.spacing_mm.maxCoeff() * 1e-3;
-  cube_edge_m_ = spacing_m * std::max(1, m.cube_voxels);
+  // The cube's longest edge (L per axis, core/cube_voxels.h): the reach and the depth limit cover it.
+  cube_edge_m_ = 0.0;
+  for (int a = 0; a < 3; ++a)
+    cube_edge_m_ = std::max(cube_edge_m_, m.grid.spacing_mm[a] * 1e-3 * std::max(1, m.cube_voxels[a]));
   // A cell of two voxels: the nearest opposed face of a slave within half a cube of sliding is in its
   // own or a neighbouring cell.
   cell_m_ = 2.0 * spacing_m;

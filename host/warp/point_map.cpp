@@ -20,7 +20,7 @@ PointMap::PointMap(const WarpMesh& mesh, const Role* roles) : mesh_(mesh), roles
 
 PointMap::Bins PointMap::bin(bool deformed) const {
   Bins b;
-  b.cell = std::max(1, mesh_.cube_voxels);
+  for (int a = 0; a < 3; ++a) b.cell[a] = std::max(1, mesh_.cube_voxels[a]);
   const int64_t T = mesh_.tet_count();
   auto vertex = [&](int64_t t, int c) {
     const int32_t n = mesh_.tets[std::size_t(t)][c];
@@ -31,14 +31,14 @@ PointMap::Bins PointMap::bin(bool deformed) const {
     for (int c = 0; c < 4; ++c) lo = lo.cwiseMin(vertex(t, c)), hi = hi.cwiseMax(vertex(t, c));
   if (T == 0) return b;
   b.min = lo.array() - 1.0;
-  for (int a = 0; a < 3; ++a) b.dims[a] = int64_t(std::floor((hi[a] + 1.0 - b.min[a]) / b.cell)) + 1;
+  for (int a = 0; a < 3; ++a) b.dims[a] = int64_t(std::floor((hi[a] + 1.0 - b.min[a]) / b.cell[a])) + 1;
   auto cell_range = [&](int64_t t, Index3& c0, Index3& c1) {
     Vec3 l = vertex(t, 0), h = l;
     for (int c = 1; c < 4; ++c) l = l.cwiseMin(vertex(t, c)), h = h.cwiseMax(vertex(t, c));
     const Vec3 margin = 4.0 * kWarpTolerance * (h - l);
     for (int a = 0; a < 3; ++a) {
-      c0[a] = std::clamp<int64_t>(int64_t(std::floor((l[a] - margin[a] - b.min[a]) / b.cell)), 0, b.dims[a] - 1);
-      c1[a] = std::clamp<int64_t>(int64_t(std::floor((h[a] + margin[a] - b.min[a]) / b.cell)), 0, b.dims[a] - 1);
+      c0[a] = std::clamp<int64_t>(int64_t(std::floor((l[a] - margin[a] - b.min[a]) / b.cell[a])), 0, b.dims[a] - 1);
+      c1[a] = std::clamp<int64_t>(int64_t(std::floor((h[a] + margin[a] - b.min[a]) / b.cell[a])), 0, b.dims[a] - 1);
     }
   };
   const int64_t cells = b.dims[0] * b.dims[1] * b.dims[2];
@@ -68,7 +68,7 @@ PointMap::Bins PointMap::bin(bool deformed) const {
 const int32_t* PointMap::Bins::begin(const Vec3& p, const int32_t*& end) const {
   int64_t c[3];
   for (int a = 0; a < 3; ++a) {
-    const double f = std::floor((p[a] - min[a]) / cell);
+    const double f = std::floor((p[a] - min[a]) / cell[a]);
     if (!(f >= 0.0 && f < double(dims[a]))) return end = nullptr;
     c[a] = int64_t(f);
   }

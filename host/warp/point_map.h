@@ -33,10 +33,11 @@ class PointMap {
   MappedPoint to_original(const Vec3& deformed_mm) const;
 
  private:
-  /// Tetrahedra binned by bounding box on a uniform grid of cells (index coordinates).
+  /// Tetrahedra binned by bounding box on a regular grid of cells (index coordinates): a cell per
+  /// lattice cube, L voxels on each axis (anisotropic when the lattice is).
   struct Bins {
     Vec3 min = Vec3::Zero();
-    double cell = 1.0;
+    Vec3 cell = Vec3::Ones();
     Index3 dims{0, 0, 0};
     std::vector<int64_t> start;   // CSR: cell c holds ids[start[c] .. start[c+1])
     std::vector<int32_t> ids;     // ascending within each cell

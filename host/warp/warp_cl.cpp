@@ -112,10 +112,10 @@ WarpResult warp_opencl(ocl::Context& ctx, const WarpMesh& mesh, const WarpSource
   cl::Buffer labels = upload_async(ctx, src.labels, has_labels ? std::size_t(n_src) : 0);
   cl::Buffer cubes = upload_async(ctx, mesh.cube_meshed.data(), mesh.cube_meshed.size());
   // The cube of every working-grid index, axis after axis (every index lies in the lattice: it has
-  // ceil(dims / L) cubes per axis).
+  // ceil(dims / L) cubes per axis, L that axis's).
   std::vector<cl_int> cube_of_host;
   for (int a = 0; a < 3; ++a)
-    for (int64_t i = 0; i < mesh.grid.dims[a]; ++i) cube_of_host.push_back(cl_int(i / mesh.cube_voxels));
+    for (int64_t i = 0; i < mesh.grid.dims[a]; ++i) cube_of_host.push_back(cl_int(i / mesh.cube_voxels[a]));
   cl::Buffer cube_of = upload_async(ctx, cube_of_host.data(), cube_of_host.size());
   cl::Buffer owner(ctx.context(), CL_MEM_READ_WRITE, std::size_t(n_out) * sizeof(cl_int));
   ctx.queue().enqueueFillBuffer(owner, cl_int(INT_MAX), 0, std::size_t(n_out) * sizeof(cl_int));

@@ -98,7 +98,7 @@ RefTet prepare(const WarpMesh& m, int64_t t, const WarpBox& box) {
 /// Whether each cube of row (j, k) was meshed at rest, indexed by cube_of_i[i]; null when the row
 /// lies beyond the lattice.
 const uint8_t* rest_row(const WarpMesh& m, int64_t j, int64_t k) {
-  const int64_t b = j / m.cube_voxels, c = k / m.cube_voxels;
+  const int64_t b = j / m.cube_voxels[1], c = k / m.cube_voxels[2];
   if (b >= m.cubes[1] || c >= m.cubes[2]) return nullptr;
   return m.cube_meshed.data() + m.cubes[0] * (b + m.cubes[1] * c);
 }
@@ -140,7 +140,8 @@ struct CubeOrder {
 
 CubeOrder cube_order(const WarpMesh& m) {
   const int64_t T = m.tet_count();
-  const double L = double(std::max(1, m.cube_voxels));
+  const Vec3 L(double(std::max(1, m.cube_voxels[0])), double(std::max(1, m.cube_voxels[1])),
+               double(std::max(1, m.cube_voxels[2])));
   const int64_t keys = 2 * m.cubes[0] * m.cubes[1] * m.cubes[2];
   std::vector<int64_t> key(static_cast<std::size_t>(T));
 #pragma omp parallel for schedule(static)
@@ -148,8 +149,8 @@ CubeOrder cube_order(const WarpMesh& m) {
     const auto& v = m.tets[std::size_t(t)];
     const Vec3 c = 0.25 * (m.rest_ijk[v[0]] + m.rest_ijk[v[1]] + m.rest_ijk[v[2]] + m.rest_ijk[v[3]]);
     int64_t q = 0;
-    for (int a = 2; a >= 0; --a) {   // cube a spans [aL − ½, (a+1)L − ½); clamped for meshes off the lattice
-      const double at = std::clamp(std::floor((c[a] + 0.5) / L), 0.0, double(m.cubes[a] - 1));
+    for (int a = 2; a >= 0; --a) {   // cube n spans [nL_a − ½, (n+1)L_a − ½); clamped for meshes off the lattice
+      const double at = std::clamp(std::floor((c[a] + 0.5) / L[a]), 0.0, double(m.cubes[a] - 1));
       q = q * m.cubes[a] + int64_t(at);
     }
     key[std::size_t(t)] = 2 * q + int64_t(m.tet_part[std::size_t(t)]);
@@ -445,7 +446,7 @@ void warp_cpu(const WarpMesh& mesh, const WarpSource& src, const WarpBox& box, c
   const int64_t nx = box.dims[0], ny = box.dims[1];
   // Cube column of each voxel column i (a table: an integer division per voxel costs more than the rest).
   std::vector<int64_t> cube_of_i(std::size_t(mesh.grid.dims[0]));
-  for (int64_t i = 0; i < mesh.grid.dims[0]; ++i) cube_of_i[std::size_t(i)] = i / mesh.cube_voxels;
+  for (int64_t i = 0; i < mesh.grid.dims[0]; ++i) cube_of_i[std::size_t(i)] = i / mesh.cube_voxels[0];
   timer.lap("allocate");
   Progress progress("warp", n_tiles);
   std::atomic<int64_t> done{0};

@@ -52,14 +52,14 @@ WarpMesh warp_mesh_on_grid(const WarpMesh& m, const Geometry& target) {
   w.cube_meshed.assign(std::size_t(target.voxel_count()), 0);
   const Mat3 to_src = a_src.inverse() * (target.direction * target.spacing_mm.asDiagonal());
   const Vec3 src0 = m.grid.to_index(target.origin_mm);
-  const double L = m.cube_voxels;
+  const CubeVoxels& L = m.cube_voxels;
   for (int64_t k = 0; k < target.dims[2]; ++k)
     for (int64_t j = 0; j < target.dims[1]; ++j)
       for (int64_t i = 0; i < target.dims[0]; ++i) {
         const Vec3 s = src0 + to_src * Vec3(double(i), double(j), double(k));
-        // Cube a spans [aL − ½, (a+1)L − ½) in the source's index coordinates.
-        const double a = std::floor((s.x() + 0.5) / L), b = std::floor((s.y() + 0.5) / L),
-                     c = std::floor((s.z() + 0.5) / L);
+        // Cube a spans [aL₀ − ½, (a+1)L₀ − ½) in the source's index coordinates, and so on per axis.
+        const double a = std::floor((s.x() + 0.5) / L[0]), b = std::floor((s.y() + 0.5) / L[1]),
+                     c = std::floor((s.z() + 0.5) / L[2]);
         if (a < 0 || b < 0 || c < 0 || a >= double(m.cubes[0]) || b >= double(m.cubes[1]) || c >= double(m.cubes[2]))
           continue;
         w.cube_meshed[std::size_t(i + target.dims[0] * (j + target.dims[1] * k))] =
@@ -76,9 +76,10 @@ void check_warp_mesh(const WarpMesh& m) {
   for (const auto& t : m.tets)
     for (int32_t n : t)
       if (n < 0 || n >= nodes) fail("node id " + std::to_string(n) + " out of range (" + std::to_string(nodes) + " nodes)");
-  if (m.cube_voxels < 1) fail("cube_voxels must be at least 1");
+  if (!m.cube_voxels.valid()) fail("cube_voxels must be at least 1 on every axis");
+  const std::array<int64_t, 3> need = m.cube_voxels.cubes_for(m.grid.dims);
   for (int a = 0; a < 3; ++a)
-    if (m.cubes[a] < (m.grid.dims[a] + m.cube_voxels - 1) / m.cube_voxels)
+    if (m.cubes[a] < need[std::size_t(a)])
       fail("the rest-space table has " + std::to_string(m.cubes[a]) + " cubes on axis " + std::to_string(a) +
            ", fewer than the grid's " + std::to_string(m.grid.dims[a]) + " voxels need");
   if (int64_t(m.cube_meshed.size()) != m.cubes[0] * m.cubes[1] * m.cubes[2]) fail("cube_meshed size");
@@ -94,8 +95,8 @@ PadVoxels growth_to_hold_deformed(const WarpMesh& m, const Index3& max_voxels) {
   }
   PadVoxels grow;
   if (!(hi.x() >= lo.x())) return grow;   // no finite node
-  const int64_t L = std::max(1, m.cube_voxels);
   for (int a = 0; a < 3; ++a) {
+    const int64_t L = std::max(1, m.cube_voxels[a]);
     // Voxel cells 0 … n−1 cover [−½, n−½): a rest node on the grid's face needs nothing, a node
     // beyond it the cells out to its place.
     const double below = -lo[a] - 0.5, above = hi[a] + 0.5 - double(m.grid.dims[a]);
@@ -107,10 +108,10 @@ PadVoxels growth_to_hold_deformed(const WarpMesh& m, const Index3& max_voxels) {
 }
 
 WarpMesh grown_warp_mesh(const WarpMesh& m, const PadVoxels& grow) {
-  const int64_t L = m.cube_voxels;
+  const CubeVoxels& L = m.cube_voxels;
   for (int a = 0; a < 3; ++a)
-    if (grow.lo[a] < 0 || grow.hi[a] < 0 || L < 1 || grow.lo[a] % L != 0)
-      throw std::invalid_argument("grown_warp_mesh: the low ends must grow by whole cubes of " + std::to_string(L) +
+    if (grow.lo[a] < 0 || grow.hi[a] < 0 || L[a] < 1 || grow.lo[a] % L[a] != 0)
+      throw std::invalid_argument("grown_warp_mesh: the low ends must grow by whole cubes of " + L.text() +
                                   " voxels and no end may shrink");
   WarpMesh g = m;
   g.grid = padded_geometry(m.grid, grow);
@@ -118,8 +119,8 @@ WarpMesh grown_warp_mesh(const WarpMesh& m, const PadVoxels& grow) {
   for (Vec3& x : g.rest_ijk) x += shift;   // displacements are differences: unchanged
   Index3 offset{0, 0, 0};
   for (int a = 0; a < 3; ++a) {
-    offset[a] = grow.lo[a] / L;
-    g.cubes[a] = std::max(m.cubes[a] + offset[a], (g.grid.dims[a] + L - 1) / L);
+    offset[a] = grow.lo[a] / L[a];
+    g.cubes[a] = std::max(m.cubes[a] + offset[a], (g.grid.dims[a] + L[a] - 1) / L[a]);
   }
   g.cube_meshed.assign(std::size_t(g.cubes[0] * g.cubes[1] * g.cubes[2]), 0);
   for (int64_t c = 0; c < m.cubes[2]; ++c)

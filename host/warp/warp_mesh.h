@@ -3,8 +3,8 @@
 // positions in the continuous voxel-index coordinates of the working grid (the roles' grid, padding
 // included), and which lattice cubes the meshes filled at rest.
 //
-// Index coordinates: voxel (i,j,k)'s centre is the point (i,j,k); a cube of L voxels spans
-// [aL − ½, (a+1)L − ½) on each axis (mesh_build.cpp's node placement). Working there turns world
+// Index coordinates: voxel (i,j,k)'s centre is the point (i,j,k); a cube of L_x voxels on axis x spans
+// [aL_x − ½, (a+1)L_x − ½) there (mesh_build.cpp's node placement), L per axis (core/cube_voxels.h). Working there turns world
 // geometry (spacing, origin, an oblique or flipped direction) into plain arithmetic once, on the
 // host, in double precision.
 //
@@ -29,7 +29,7 @@ struct WarpMesh {
   std::vector<std::array<int32_t, 4>> tets;
   std::vector<Part> tet_part;
   // Rest space: the lattice cubes holding any tetrahedron; a voxel lies in it iff its cube does.
-  int cube_voxels = 0;
+  CubeVoxels cube_voxels{0};
   std::array<int64_t, 3> cubes{0, 0, 0};
   std::vector<uint8_t> cube_meshed;               // cubes[0]·cubes[1]·cubes[2], a fastest
 
@@ -39,8 +39,7 @@ struct WarpMesh {
   /// (cavity_enclosure.h) asks it for most of 10⁸ voxels.
   bool in_rest_space(int64_t i, int64_t j, int64_t k) const {
     if (i < 0 || j < 0 || k < 0) return false;
-    const int64_t L = cube_voxels;
-    const int64_t a = i / L, b = j / L, c = k / L;
+    const int64_t a = i / cube_voxels[0], b = j / cube_voxels[1], c = k / cube_voxels[2];
     if (a >= cubes[0] || b >= cubes[1] || c >= cubes[2]) return false;
     return cube_meshed[std::size_t(a + cubes[0] * (b + cubes[1] * c))] != 0;
   }
@@ -58,7 +57,7 @@ WarpMesh make_warp_mesh(const Mesh& mesh, const std::vector<Vec3>& displacement_
 
 /// How much to grow m.grid so that every deformed node lies in one of its voxels' cells: the output
 /// grid of a body that moved out of the CT (issue "A human answer", item 5). Whole cubes at the low
-/// ends, so that cube a keeps its place [aL − ½, (a+1)L − ½) in the lattice after the shift; single
+/// ends (of that axis's L), so that cube a keeps its place [aL − ½, (a+1)L − ½) in the lattice after the shift; single
 /// voxels at the high ends; nothing on a side the nodes stay inside. No end grows by more than
 /// `max_voxels` on its axis (rounded down to whole cubes at the low ends): a node flung far by a
 /// diverged solve must not ask for gigabytes. Non-finite positions are skipped.
