@@ -1,9 +1,14 @@
-// Cubes of per-axis voxel counts (core/cube_voxels.h, issue 58 item 4).
+// Cubes sized per axis (core/cube_voxels.h, issue 58 item 4): mesh.cube_mm gives each axis of the grid the
+// whole number of voxels nearest to it, so cubes are near-cubic on anisotropic (clinical) grids.
+//  - The rounding: every edge within half a voxel of cube_mm (at least one voxel), the presets' sizes on a
+//    0.75 × 0.75 × 2.5 mm grid as the docs state them, and one L on every axis of an isotropic grid (the
+//    meshes of before, unchanged).
 //  - The scene: mesh.cube_voxels as one integer or [i, j, k], its messages, its echo.
 //  - The mesh on an oblique anisotropic grid with cubes of 3 × 2 × 1 voxels: exact invariants (the lattice
 //    edges are the cube's edges per axis to 1e-12; the tetrahedra's rest volumes sum to the meshed cubes'
 //    volume, |det A|·L₀L₁L₂ each, to 1e-12 relative; a cube full of one tissue fills each of its
 //    tetrahedra, fraction exactly 1, though its sample counts per axis differ).
+//  - The pipeline's mesh of a scene at cube_mm 9 on a 1 × 1 × 3 mm grid: lattice spacing 9 mm on each axis.
 //  - deformation.bin: version 2 written; a version 1 file still read for a mesh of one L, refused for another.
 #include <gtest/gtest.h>
 
@@ -51,6 +56,26 @@ std::vector<Role> block_roles(const Geometry& g) {
 
 }  // namespace
 
+TEST(CubeVoxels, CubeMmGivesEveryAxisItsNearestWholeVoxels) {
+  // On 0.75 × 0.75 × 2.5 mm voxels (a clinical abdomen): the presets' 12, 9 and 6 mm cubes.
+  const Vec3 clinical(0.75, 0.75, 2.5);
+  EXPECT_EQ(cube_voxels_for_mm(12.0, clinical), CubeVoxels(16, 16, 5));
+  EXPECT_EQ(cube_voxels_for_mm(9.0, clinical), CubeVoxels(12, 12, 4));
+  EXPECT_EQ(cube_voxels_for_mm(6.0, clinical), CubeVoxels(8, 8, 2));
+  EXPECT_EQ(cube_voxels_for_mm(9.0, clinical).text(), "12×12×4");
+  EXPECT_EQ(cube_voxels_for_mm(0.1, clinical), CubeVoxels(1));   // at least one voxel
+  // Within half a voxel of cube_mm on every axis, for grids from isotropic to 1:6.
+  for (const Vec3& s : {Vec3(0.7, 0.7, 2.5), Vec3(1.0, 1.0, 3.0), Vec3(0.5, 0.9, 3.0), Vec3(1.5, 1.5, 1.5)})
+    for (double mm = 3.0; mm <= 16.0; mm += 0.5) {
+      const CubeVoxels c = cube_voxels_for_mm(mm, s);
+      for (int a = 0; a < 3; ++a)
+        if (c[a] > 1) EXPECT_LE(std::abs(c.edge_mm(s)[a] - mm), 0.5 * s[a] + 1e-12) << mm << " mm, axis " << a;
+    }
+  // An isotropic grid: one L, the nearest whole number of voxels, as the single L always was.
+  for (double mm : {4.5, 6.0, 9.0, 12.0})
+    EXPECT_EQ(cube_voxels_for_mm(mm, Vec3::Constant(1.5)), CubeVoxels(int(std::lround(mm / 1.5))));
+}
+
 TEST(CubeVoxels, SceneTakesOneIntegerOrOnePerAxis) {
   const Scene one = parse_scene({{"mesh", {{"cube_voxels", 5}}}}, "scene.json");
   EXPECT_EQ(one.mesh.cube_voxels, CubeVoxels(5));
@@ -72,10 +97,13 @@ TEST(CubeVoxels, SceneTakesOneIntegerOrOnePerAxis) {
   EXPECT_NE(message({{"cube_voxels", {12, 12}}}).find("expected an integer or an array of 3 integers"), std::string::npos)
       << message({{"cube_voxels", {12, 12}}});
   EXPECT_NE(message({{"cube_voxels", {12, 12, 4.5}}}).find("has the wrong type"), std::string::npos);
-  // Unset cube_mm: cube_voxels as given.
+  // cube_mm wins, per axis on the CT's grid; unset, cube_voxels as given.
   SceneMesh m;
   m.cube_voxels = CubeVoxels(2, 3, 4);
-  EXPECT_EQ(cube_voxels_for(m, grid({10, 10, 10}, Vec3(0.75, 0.75, 2.5))), CubeVoxels(2, 3, 4));
+  const Geometry g = grid({10, 10, 10}, Vec3(0.75, 0.75, 2.5));
+  EXPECT_EQ(cube_voxels_for(m, g), CubeVoxels(2, 3, 4));
+  m.cube_mm = 9.0;
+  EXPECT_EQ(cube_voxels_for(m, g), CubeVoxels(12, 12, 4));
 }
 
 TEST(CubeVoxels, MeshOfPerAxisCubesKeepsItsVolumeInvariants) {
@@ -131,6 +159,28 @@ TEST(CubeVoxels, MeshOfPerAxisCubesKeepsItsVolumeInvariants) {
       ++checked;
     }
   EXPECT_EQ(checked, 5);
+}
+
+TEST(CubeVoxels, SceneMeshAtCubeMmIsNearCubicOnAnAnisotropicGrid) {
+  // 1 × 1 × 3 mm voxels at the balanced preset's 9 mm: 9 × 9 × 3 voxels, 9 mm on every axis. By one L
+  // from the coarsest axis (the rule before) the cubes were 3 × 3 × 9 mm, nine times as many.
+  const Geometry g = grid({40, 40, 14}, Vec3(1.0, 1.0, 3.0));
+  const std::vector<Role> roles = block_roles(g);
+  Scene scene = parse_scene({{"mesh", {{"model", "wall_viscera"}}}}, "scene.json");
+  scene.mesh.cube_mm = 9.0;
+  const Mesh m = build_scene_mesh(VoxelRoles{g, roles.data(), nullptr}, scene);
+  EXPECT_EQ(m.cube_voxels, CubeVoxels(9, 9, 3));
+  const Vec3 edge = m.cube_voxels.edge_mm(g.spacing_mm);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(edge[a], 9.0, 0.5 * g.spacing_mm[a]);
+  // Node spacing along each axis, measured on the mesh.
+  Vec3 lo = Vec3::Constant(1e9), hi = -lo;
+  Index3 lat_hi{0, 0, 0};
+  for (int64_t n = 0; n < m.node_count(); ++n) {
+    lo = lo.cwiseMin(m.rest_m[n]);
+    hi = hi.cwiseMax(m.rest_m[n]);
+    for (int a = 0; a < 3; ++a) lat_hi[a] = std::max<int64_t>(lat_hi[a], m.node_lattice[n][a]);
+  }
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(1e3 * (hi[a] - lo[a]) / double(lat_hi[a]), 9.0, 1e-9) << "axis " << a;
 }
 
 TEST(CubeVoxels, DeformationFileOfVersionOneIsReadForOneLAndRefusedOtherwise) {

@@ -70,7 +70,7 @@ TEST(ScenePresets, EchoParsesBackToTheSameScene) {
   EXPECT_EQ(parse_scene(s.echo(), kOrigin).echo(), s.echo());
 }
 
-TEST(ScenePresets, CubeMmGivesTheNearestWholeVoxelsAlongTheCoarsestAxis) {
+TEST(ScenePresets, CubeMmGivesTheNearestWholeVoxelsAlongEachAxis) {
   Geometry g;
   g.dims = {10, 10, 10};
   g.spacing_mm = Vec3(0.75, 0.75, 1.5);
@@ -78,7 +78,7 @@ TEST(ScenePresets, CubeMmGivesTheNearestWholeVoxelsAlongTheCoarsestAxis) {
   m.cube_voxels = 5;
   EXPECT_EQ(cube_voxels_for(m, g), 5);   // unset: cube_voxels
   m.cube_mm = 9.0;
-  EXPECT_EQ(cube_voxels_for(m, g), 6);
+  EXPECT_EQ(cube_voxels_for(m, g), CubeVoxels(12, 12, 6));   // 9 mm on every axis (by the coarsest: 4.5 × 4.5 × 9)
   m.cube_mm = 0.2;
   EXPECT_EQ(cube_voxels_for(m, g), 1);   // at least one voxel
 }

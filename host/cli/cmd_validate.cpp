@@ -55,7 +55,7 @@ Run add_validate(CLI::App& app) {
   auto* conv = cmd->add_subcommand(
       "convergence", "One scene solved with several cube sizes: rise, cavity and wall displacement, with the observed order");
   conv->add_option("scene", o->scene, "Scene .json")->required();
-  conv->add_option("--cube-voxels", o->cube_voxels, "Cube sizes in voxels, coarse to fine")
+  conv->add_option("--cube-voxels", o->cube_voxels, "Cube sizes in voxels along the CT's coarsest axis, coarse to fine (the other axes near-cubic)")
       ->delimiter(',')
       ->capture_default_str();
   conv->add_flag("--json", o->json, "Print JSON (rows, observed_order and extrapolated value per quantity)");
@@ -128,10 +128,10 @@ Run add_validate(CLI::App& app) {
         std::cout << to_json(s).dump(2) << "\n";
         return 0;
       }
-      std::printf("%-6s %-8s %-10s %-12s %-12s %-12s %-9s %-8s %s\n", "cube", "cube_mm", "rise_mm", "cavity_ml",
+      std::printf("%-8s %-8s %-10s %-12s %-12s %-12s %-9s %-8s %s\n", "cube", "cube_mm", "rise_mm", "cavity_ml",
                   "wall_mean_mm", "viscera_back", "nodes", "inverted", "converged");
       for (const ConvergenceRow& r : s.rows)
-        std::printf("%-6d %-8.1f %-10.2f %-12.1f %-12.2f %-12.2f %-9lld %-8lld %s\n", r.cube_voxels, r.cube_mm,
+        std::printf("%-8s %-8.1f %-10.2f %-12.1f %-12.2f %-12.2f %-9lld %-8lld %s\n", r.cube.text().c_str(), r.cube_mm,
                     r.anterior_rise_mm, r.cavity_volume_ml, r.mean_wall_displacement_mm, r.viscera_posterior_motion_mm,
                     (long long)r.nodes, (long long)r.inverted, r.converged ? "yes" : "no");
       auto line = [](const char* what, const ObservedOrder& oo) {

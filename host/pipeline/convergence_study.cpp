@@ -47,15 +47,19 @@ ConvergenceStudy convergence_study(const Scene& scene, const std::vector<int>& c
   }
   ConvergenceStudy s;
   std::vector<double> h, rise, volume, wall, viscera;
+  // The working grid's spacing (the CT's: padding adds voxels, not spacing), for cubes of L coarsest voxels in mm
+  // with every axis near it. On an isotropic grid that is L on every axis, as the study always meshed.
+  const Vec3 spacing_mm = load_roles(scene).geometry.spacing_mm;
   for (const int L : cube_voxels) {
     Scene sc = scene;
-    sc.mesh.cube_mm.reset();
-    sc.mesh.cube_voxels = L;
-    log::info("convergence: cube_voxels " + std::to_string(L));
+    sc.mesh.cube_mm = L * spacing_mm.maxCoeff();
+    log::info("convergence: cube_voxels " + std::to_string(L) + " along the coarsest axis");
     const Simulation sim = simulate_scene(sc);
     const DeformationMetrics d = deformation_metrics(sim.mesh, sim.result.x);
     ConvergenceRow r;
     r.cube_voxels = L;
+    r.cube = sim.mesh.cube_voxels;
+    r.cube_edge_mm = r.cube.edge_mm(sim.roles.geometry.spacing_mm);
     r.cube_mm = L * sim.roles.geometry.spacing_mm.maxCoeff();
     r.anterior_rise_mm = d.anterior_rise_mm;
     r.cavity_volume_ml = d.cavity_volume_ml;
@@ -88,7 +92,9 @@ nlohmann::json to_json(const ConvergenceStudy& s) {
   nlohmann::json rows = nlohmann::json::array();
   for (const ConvergenceRow& r : s.rows)
     rows.push_back({{"cube_voxels", r.cube_voxels},
+                    {"cube_voxels_per_axis", {r.cube[0], r.cube[1], r.cube[2]}},
                     {"cube_mm", r.cube_mm},
+                    {"cube_edge_mm", {r.cube_edge_mm[0], r.cube_edge_mm[1], r.cube_edge_mm[2]}},
                     {"anterior_rise_mm", r.anterior_rise_mm},
                     {"cavity_volume_ml", r.cavity_volume_ml},
                     {"mean_wall_displacement_mm", r.mean_wall_displacement_mm},

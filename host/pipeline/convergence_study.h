@@ -11,8 +11,10 @@
 namespace pneumo {
 
 struct ConvergenceRow {
-  int cube_voxels = 0;
+  int cube_voxels = 0;                // L as given: voxels along the CT's coarsest axis
+  CubeVoxels cube{0};                 // the voxels per axis of near-cubic cubes of cube_mm (cube_voxels_for_mm)
   double cube_mm = 0;                 // L × the CT's largest spacing
+  Vec3 cube_edge_mm = Vec3::Zero();   // the edge each axis got
   double anterior_rise_mm = 0, cavity_volume_ml = 0, mean_wall_displacement_mm = 0;
   double viscera_posterior_motion_mm = 0;   // mean over the viscera's anterior half (cavity_measures.h)
   int64_t nodes = 0, inverted = 0, steps = 0;
@@ -36,8 +38,9 @@ struct ConvergenceStudy {
   double finest_change_rise = 0, finest_change_volume = 0;
 };
 
-/// Solves `scene` with each mesh.cube_voxels in `cube_voxels` (coarse to fine, at least 2), every other
-/// key as the scene says.
+/// Solves `scene` with cubes of each L in `cube_voxels` (coarse to fine, at least 2) voxels along the CT's
+/// coarsest axis, mesh.cube_mm = L × that spacing, so the finer axes take as many voxels as keep the cubes
+/// near-cubic (on an isotropic grid: L on every axis); every other key as the scene says.
 ConvergenceStudy convergence_study(const Scene& scene, const std::vector<int>& cube_voxels);
 nlohmann::json to_json(const ConvergenceStudy& s);
 

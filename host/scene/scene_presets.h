@@ -37,8 +37,8 @@ std::optional<ScenePreset> find_preset(const nlohmann::json& scene);
 /// The reference text of the "preset" key: each preset's settings and what it measured to buy.
 const std::string& preset_reference_text();
 
-/// The cube voxels of a scene's mesh on a grid: cube_mm when set (the nearest whole number of voxels along the
-/// coarsest axis, at least 1, on every axis), else cube_voxels.
+/// The cube voxels of a scene's mesh on a grid: cube_mm when set (per axis the nearest whole number of voxels, at
+/// least 1: cube_voxels_for_mm), else cube_voxels.
 CubeVoxels cube_voxels_for(const SceneMesh& mesh, const Geometry& grid);
 
 }  // namespace pneumo
