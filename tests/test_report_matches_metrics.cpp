@@ -414,6 +414,8 @@ json distinctive_value(const std::string& key, int i) {
   if (kBooleans.count(key)) return true;
   if (kStrings.count(key)) return key + " <&> \"text\"";
   if (key == "warp.cavity_centroid_mm") return json::array({-12.34, 56.78, 901.2});
+  if (key == "cube_edge_mm") return json::array({8.963, 9.012, 10.37});   // per axis, as simulate writes it
+  if (key == "cube_voxels") return json::array({13, 12, 4});
   if (kCounts.count(key)) return 12 + 1237 * i;
   if (ends_with(key, "_fraction")) return 0.0371 + 0.0113 * i;
   return (i % 2 ? -1.0 : 1.0) * (1.234 + 7.919 * i);
@@ -506,5 +508,14 @@ TEST(ReportMatchesMetrics, ARealRunsReportIsItsMetricsJson) {
   const json m = json::parse(testing_support::read_bytes(d.file("run/metrics.json")));
   ASSERT_TRUE(m.contains("pressure_curve"));
   ASSERT_TRUE(m.contains("landmarks"));
-  expect_report_matches(testing_support::read_bytes(d.file("run/report.html")), m);
+  // The mesh's size in the user's terms (issue 58 item 4): the cube's edge per axis in mm and the
+  // element count, both in metrics.json and so, by the check below, on the page.
+  ASSERT_TRUE(m.contains("cube_edge_mm"));
+  ASSERT_EQ(m["cube_edge_mm"].size(), 3u);
+  for (const json& e : m["cube_edge_mm"]) EXPECT_GT(e.get<double>(), 0.0);
+  EXPECT_GT(m["tetrahedra"].get<int64_t>(), 0);
+  const std::string html = testing_support::read_bytes(d.file("run/report.html"));
+  EXPECT_NE(html.find("Mesh cube edge per axis"), std::string::npos);
+  EXPECT_NE(html.find("Tetrahedra (elements)"), std::string::npos);
+  expect_report_matches(html, m);
 }

@@ -55,7 +55,10 @@ Simulation prepare_simulation(const Scene& scene, bool keep_inputs) {
   sim.stage_seconds_mesh = seconds_since(t0);
   const MeshStats& s = sim.mesh.stats;
   std::ostringstream os;
-  os << "mesh: " << s.nodes << " nodes, " << s.tetrahedra << " tetrahedra, " << s.springs << " springs, "
+  const Vec3 edge_mm = sim.mesh.cube_voxels.edge_mm(sim.mesh.grid.spacing_mm);
+  os.precision(3);
+  os << "mesh: cubes of " << sim.mesh.cube_voxels.text() << " voxels (" << edge_mm[0] << " × " << edge_mm[1] << " × "
+     << edge_mm[2] << " mm), " << s.nodes << " nodes, " << s.tetrahedra << " tetrahedra, " << s.springs << " springs, "
      << s.cavity_faces << " cavity faces, " << s.fixed_nodes << " fixed nodes, " << s.doubled_cubes
      << " doubled cubes";
   log::info(os.str());
@@ -215,9 +218,11 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   j["stop_reason"] = stop_reason_text(r.stop_reason);
   j["solver"] = r.solver;
   j["pressure_mmhg"] = r.final_pressure_pa / units::kPaPerMmHg;
-  // As the scene writes it: one integer when every axis agrees.
+  // As the scene writes it (one integer when every axis agrees), and the edge each axis gives in mm.
   const CubeVoxels& cube = sim.mesh.cube_voxels;
   j["cube_voxels"] = cube.uniform() ? nlohmann::json(cube[0]) : nlohmann::json::array({cube[0], cube[1], cube[2]});
+  const Vec3 edge_mm = cube.edge_mm(sim.mesh.grid.spacing_mm);
+  j["cube_edge_mm"] = {edge_mm[0], edge_mm[1], edge_mm[2]};
   j["nodes"] = s.nodes;
   j["tetrahedra"] = s.tetrahedra;
   j["springs"] = s.springs;
