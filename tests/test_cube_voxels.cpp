@@ -68,8 +68,11 @@ TEST(CubeVoxels, CubeMmGivesEveryAxisItsNearestWholeVoxels) {
   for (const Vec3& s : {Vec3(0.7, 0.7, 2.5), Vec3(1.0, 1.0, 3.0), Vec3(0.5, 0.9, 3.0), Vec3(1.5, 1.5, 1.5)})
     for (double mm = 3.0; mm <= 16.0; mm += 0.5) {
       const CubeVoxels c = cube_voxels_for_mm(mm, s);
-      for (int a = 0; a < 3; ++a)
-        if (c[a] > 1) EXPECT_LE(std::abs(c.edge_mm(s)[a] - mm), 0.5 * s[a] + 1e-12) << mm << " mm, axis " << a;
+      for (int a = 0; a < 3; ++a) {
+        if (c[a] > 1) {
+          EXPECT_LE(std::abs(c.edge_mm(s)[a] - mm), 0.5 * s[a] + 1e-12) << mm << " mm, axis " << a;
+        }
+      }
     }
   // An isotropic grid: one L, the nearest whole number of voxels, as the single L always was.
   for (double mm : {4.5, 6.0, 9.0, 12.0})
