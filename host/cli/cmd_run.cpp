@@ -2,6 +2,7 @@
 
 #include "cl/cl_runtime.h"
 #include "cli/commands.h"
+#include "cli/scene_inputs_options.h"
 #include "core/output_lock.h"
 #include "pipeline/run.h"
 
@@ -11,12 +12,13 @@ Run add_run(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "run", "The whole case: roles, mesh, solver, warp, render and report.html into --out (what the demo runs)");
   struct Opts {
-    std::string scene, out, device, backend = "auto";
+    SceneSource source;
+    std::string out, device, backend = "auto";
     bool force = false, resume = false;
     int64_t timelapse = -1;
   };
   auto o = std::make_shared<Opts>();
-  cmd->add_option("scene", o->scene, "Scene .json")->required();
+  add_scene_source_options(cmd, o->source);
   cmd->add_option("--out", o->out, "Output folder")->required();
   cmd->add_option("--device", o->device, "cpu (the C++ reference), auto (an OpenCL GPU if there is one, else cpu), opencl or opencl:P:D; overrides the scene's device");
   cmd->add_option("--backend", o->backend, "Offscreen OpenGL: auto, egl-device, egl-surfaceless or osmesa");
@@ -27,7 +29,7 @@ Run add_run(CLI::App& app) {
                   "into --out/timelapse (overrides output.timelapse_every_steps; 0: off)")
       ->check(CLI::Range(int64_t(0), int64_t(1000000000)));
   return [=] {
-    Scene scene = load_scene(o->scene);
+    Scene scene = load_scene_source(o->source);
     if (!o->device.empty()) scene.device = o->device;
     ocl::parse_device_spec(scene.device);   // a bad --device is bad input before any work
     const OutputFolderLock lock(o->out);   // one pneumo at a time in --out (core/output_lock.h)
