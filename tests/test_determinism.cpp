@@ -36,7 +36,7 @@ Scene phantom_scene(const ScratchDir& dir) {
   Progress::set_enabled(false);
   write_phantom_case(make_phantom(PhantomSize::Small), PhantomSize::Small, dir.path().string());
   Scene scene = load_scene(dir.file("scene.json"));
-  scene.mesh.cube_voxels = CubeVoxels(2 * scene.mesh.cube_voxels[0]);   // the phantom's one L, doubled
+  scene.mesh.cube_voxels = CubeVoxels(2 * scene.mesh.cube_voxels.value()[0]);   // the phantom's one L, doubled
   scene.solver.residual_tolerance = 1e-2;
   return scene;
 }

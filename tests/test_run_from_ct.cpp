@@ -25,7 +25,7 @@ TEST(RunFromCt, TheCtAndItsLabelsAloneGiveTheExamplesAnswer) {
   std::ifstream u(out + "/scene_used.json");
   const nlohmann::json used = nlohmann::json::parse(u);
   EXPECT_EQ(used["roles"]["viscera_labels"], nlohmann::json(std::vector<int>(kHandViscera)));
-  EXPECT_DOUBLE_EQ(used["mesh"]["cube_mm"].get<double>(), 9.0);
+  EXPECT_EQ(metrics["cube_edge_mm"], nlohmann::json({9.0, 9.0, 9.0}));
   // The label tables name the structures from the map's header.
   std::ifstream t(out + "/deformed_labels.ctbl");
   const std::string table((std::istreambuf_iterator<char>(t)), std::istreambuf_iterator<char>());

@@ -19,6 +19,7 @@
 #include "core/error.h"
 #include "scene/param_table.h"
 #include "scene/scene.h"
+#include "scene/scene_presets.h"
 
 namespace pneumo {
 namespace {
@@ -133,7 +134,13 @@ json other_value(const ParamInfo& p, const json& current, int serial) {
 TEST(SceneDefaults, MatchMethodAndTable) {
   const Scene s = default_scene();
   // method.md §4 (Nimura's values) and the choices written down in scene.h.
-  EXPECT_EQ(s.mesh.cube_voxels, 8);
+  // No cube size given: kDefaultCubeMm (9 mm, the balanced preset's) on any grid, 3 voxels on a 3 mm one.
+  EXPECT_FALSE(s.mesh.cube_voxels.has_value());
+  EXPECT_FALSE(s.mesh.cube_mm.has_value());
+  Geometry three_mm;
+  three_mm.dims = {10, 10, 10};
+  three_mm.spacing_mm = Vec3::Constant(3.0);
+  EXPECT_EQ(cube_voxels_for(s.mesh, three_mm), CubeVoxels(3));
   EXPECT_EQ(s.material.density_kg_m3, 1096.0);
   EXPECT_EQ(s.material.young_kpa, 60.0);
   EXPECT_EQ(s.material.damping_ratio, 0.4);

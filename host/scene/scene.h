@@ -33,8 +33,10 @@ struct SceneInputs {
 };
 
 struct SceneMesh {
-  CubeVoxels cube_voxels{8};  // L per axis, Nimura's value (§4 defaults) on each
-  std::optional<double> cube_mm;  // when set, L per axis from the CT's spacing (cube_voxels_for)
+  // The cube size: cube_mm when set (L per axis from the CT's spacing), else cube_voxels when set, else
+  // kDefaultCubeMm (scene_presets.h: cube_voxels_for).
+  std::optional<CubeVoxels> cube_voxels;
+  std::optional<double> cube_mm;
   MeshModel model = MeshModel::WallViscera;
   std::optional<Vec3> roi_min_mm, roi_max_mm;  // both or neither
   std::vector<int> attached_labels;   // wall labels whose interface with the viscera stays closed

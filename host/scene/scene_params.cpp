@@ -152,7 +152,7 @@ const Table<SceneMesh>& mesh_table() {
       {"cube_voxels", &SceneMesh::cube_voxels, "voxels", in(1, 64),
        "L: each mesh cube covers L×L×L voxels, split into 5 tetrahedra (§3; Nimura: 8); [i, j, k]: that many voxels "
        "along each axis of the CT's grid, for near-cubic cubes on anisotropic voxels (e.g. [12, 12, 4] on "
-       "0.75×0.75×2.5 mm). Ignored where cube_mm is set; a scene file that gives neither gets cube_mm 9."},
+       "0.75×0.75×2.5 mm). Ignored where cube_mm is set. Unset with cube_mm unset too: 9 mm cubes (the balanced preset's), near-cubic on any grid."},
       {"cube_mm", &SceneMesh::cube_mm, "mm", above(0, 1000),
        "Cube edge in mm instead of voxels: on each axis of the CT's grid, the whole number of voxels nearest to it "
        "(at least 1), so cubes are near-cubic on any grid, each edge within half a voxel of cube_mm (9 on "

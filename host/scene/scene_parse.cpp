@@ -187,16 +187,6 @@ nlohmann::json model_patch(MaterialModel model) {
   return nlohmann::json::object();
 }
 
-/// A scene that sizes its cubes neither way (nor through a preset) gets kDefaultCubeMm: cubes of the
-/// same size in millimetres on every CT, where Nimura's 8 voxels were 24 mm on a 3 mm CT and 5.6 mm
-/// (and 846 k elements) on a 0.7 mm one.
-void fill_default_cube_size(nlohmann::json& scene) {
-  if (!scene.is_object()) return;
-  const auto mesh = scene.find("mesh");
-  if (mesh != scene.end() && (!mesh->is_object() || mesh->contains("cube_voxels") || mesh->contains("cube_mm"))) return;
-  scene["mesh"]["cube_mm"] = kDefaultCubeMm;
-}
-
 }  // namespace
 
 Scene parse_scene(const nlohmann::json& j, const std::string& origin_path) {
@@ -218,7 +208,6 @@ Scene parse_scene(const nlohmann::json& j, const std::string& origin_path) {
   if (const std::optional<ScenePreset> p = find_preset(j); p && *p != ScenePreset::None)
     fill_absent(merged, preset_patch(*p, model));
   fill_absent(merged, model_patch(model));
-  fill_default_cube_size(merged);
   scene_detail::scene_table().read(s, merged, scene_detail::At{&ctx, ""});
   scene_detail::assign_roles_by_name(s, merged);
   scene_detail::validate_scene(s, ctx);

@@ -86,7 +86,8 @@ const std::string& preset_reference_text() {
 }
 
 CubeVoxels cube_voxels_for(const SceneMesh& mesh, const Geometry& grid) {
-  if (!mesh.cube_mm) return mesh.cube_voxels;
+  if (!mesh.cube_mm && mesh.cube_voxels) return *mesh.cube_voxels;
+  if (!mesh.cube_mm) return cube_voxels_for_mm(kDefaultCubeMm, grid.spacing_mm);
   // Per axis, not by the coarsest spacing: on 0.7 × 0.7 × 2.5 mm voxels one L from the coarsest axis made
   // 9 mm cubes 2.8 × 2.8 × 10 mm, twelve times the elements of 9 mm cubes, for no accuracy in z.
   return cube_voxels_for_mm(*mesh.cube_mm, grid.spacing_mm);

@@ -13,8 +13,10 @@
 
 namespace pneumo {
 
-/// The cube edge of a scene that gives none (mesh.cube_voxels, mesh.cube_mm or a preset): the balanced
-/// preset's, measured within 1 % of 3 mm cubes' rise and cavity on the real CT (docs/performance.md).
+/// The cube edge of a scene that sizes its cubes in no way (mesh.cube_voxels, mesh.cube_mm or a preset):
+/// the balanced preset's, measured within 1 % of 3 mm cubes' rise and cavity on the real CT
+/// (docs/performance.md). Nimura's 8 voxels were 24 mm on a 3 mm CT and 5.6 mm (846 k elements) on a
+/// 0.7 mm one.
 inline constexpr double kDefaultCubeMm = 9.0;
 
 struct PresetSettings {
@@ -42,7 +44,7 @@ std::optional<ScenePreset> find_preset(const nlohmann::json& scene);
 const std::string& preset_reference_text();
 
 /// The cube voxels of a scene's mesh on a grid: cube_mm when set (per axis the nearest whole number of voxels, at
-/// least 1: cube_voxels_for_mm), else cube_voxels.
+/// least 1: cube_voxels_for_mm), else cube_voxels, else kDefaultCubeMm's.
 CubeVoxels cube_voxels_for(const SceneMesh& mesh, const Geometry& grid);
 
 }  // namespace pneumo
