@@ -292,6 +292,28 @@ TEST(FemField, RigidMotionOfTheMeshGivesNoForce) {
   }
 }
 
+namespace {
+
+/// The patch test's state: the boundary nodes of `m` held at x = A x₀ (hold set here), the interior
+/// ones started off it by up to 0.3 mm at random; `interior` counts those.
+std::vector<Vec3> patch_test_start(Mesh& m, const Mat3& A, std::mt19937& rng, int& interior) {
+  Vec3 lo = Vec3::Constant(1e9), hi = Vec3::Constant(-1e9);
+  for (const Vec3& p : m.rest_m) { lo = lo.cwiseMin(p); hi = hi.cwiseMax(p); }
+  std::vector<Vec3> start(m.node_count());
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  interior = 0;
+  for (int64_t n = 0; n < m.node_count(); ++n) {
+    const Vec3& p = m.rest_m[n];
+    const bool boundary = ((p - lo).cwiseAbs().minCoeff() < 1e-9) || ((hi - p).cwiseAbs().minCoeff() < 1e-9);
+    m.hold[n] = boundary ? kHoldAll : 0;
+    start[n] = A * p + (boundary ? Vec3::Zero() : Vec3(0.3e-3 * Vec3(u(rng), u(rng), u(rng))));
+    interior += !boundary;
+  }
+  return start;
+}
+
+}  // namespace
+
 TEST(FemField, PatchTestReproducesAUniformStrainExactly) {
   // The patch test: the boundary nodes of a solid block held at x = A x₀ (a uniform strain of up to 5 %
   // with a rotation), the interior nodes started off it at random; Newton must put every interior node
@@ -303,18 +325,8 @@ TEST(FemField, PatchTestReproducesAUniformStrainExactly) {
   std::mt19937 rng(kSeed + 6);
   Mesh m = block_mesh(4, 1, /*shell=*/false);
   const Mat3 A = rotation(Vec3(1, 1, 0), 0.3) * (Mat3::Identity() + random_matrix(rng, 0.05));
-  Vec3 lo = Vec3::Constant(1e9), hi = Vec3::Constant(-1e9);
-  for (const Vec3& p : m.rest_m) { lo = lo.cwiseMin(p); hi = hi.cwiseMax(p); }
-  std::vector<Vec3> start(m.node_count());
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
   int interior = 0;
-  for (int64_t n = 0; n < m.node_count(); ++n) {
-    const Vec3& p = m.rest_m[n];
-    const bool boundary = ((p - lo).cwiseAbs().minCoeff() < 1e-9) || ((hi - p).cwiseAbs().minCoeff() < 1e-9);
-    m.hold[n] = boundary ? kHoldAll : 0;
-    start[n] = A * p + (boundary ? Vec3::Zero() : Vec3(0.3e-3 * Vec3(u(rng), u(rng), u(rng))));
-    interior += !boundary;
-  }
+  const std::vector<Vec3> start = patch_test_start(m, A, rng, interior);
   ASSERT_GT(interior, 20);
   Progress::set_enabled(false);
   for (const std::string& device : testing_support::cpu_and_opencl_device_specs())
@@ -360,16 +372,8 @@ TEST(FemField, PatchTestHoldsOnCubesOfPerAxisVoxels) {
   for (const Vec3& p : m.rest_m) { lo = lo.cwiseMin(p); hi = hi.cwiseMax(p); }
   EXPECT_NEAR((hi - lo).minCoeff(), 20e-3, 1e-12);
   EXPECT_NEAR((hi - lo).maxCoeff(), 20e-3, 1e-12);
-  std::vector<Vec3> start(m.node_count());
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
   int interior = 0;
-  for (int64_t n = 0; n < m.node_count(); ++n) {
-    const Vec3& p = m.rest_m[n];
-    const bool boundary = ((p - lo).cwiseAbs().minCoeff() < 1e-9) || ((hi - p).cwiseAbs().minCoeff() < 1e-9);
-    m.hold[n] = boundary ? kHoldAll : 0;
-    start[n] = A * p + (boundary ? Vec3::Zero() : Vec3(0.3e-3 * Vec3(u(rng), u(rng), u(rng))));
-    interior += !boundary;
-  }
+  const std::vector<Vec3> start = patch_test_start(m, A, rng, interior);
   ASSERT_EQ(interior, 27);
   Progress::set_enabled(false);
   for (const FieldCase& c : kFields) {
