@@ -48,7 +48,10 @@ Simulation prepare_simulation(const Scene& scene, bool keep_inputs) {
   Simulation sim;
   auto t0 = std::chrono::steady_clock::now();
   sim.roles = load_roles(scene, keep_inputs ? &sim.inputs : nullptr);
+  sim.coverage = scan_coverage(sim.roles, scene.roles.label_names.empty() ? scene_label_names(scene) : scene.roles.label_names);
   sim.stage_seconds_roles = seconds_since(t0);
+  log::info("scan: " + sim.coverage.summary);
+  for (const std::string& w : sim.coverage.warnings) log::warn("scan: " + w);
 
   t0 = std::chrono::steady_clock::now();
   sim.mesh = build_scene_mesh(VoxelRoles{sim.roles.geometry, sim.roles.role.data(), sim.roles.label.data(), sim.roles.hu()}, scene, /*to_solve=*/true);
@@ -223,6 +226,19 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   j["cube_voxels"] = cube.uniform() ? nlohmann::json(cube[0]) : nlohmann::json::array({cube[0], cube[1], cube[2]});
   const Vec3 edge_mm = cube.edge_mm(sim.mesh.grid.spacing_mm);
   j["cube_edge_mm"] = {edge_mm[0], edge_mm[1], edge_mm[2]};
+  const ScanCoverage& c = sim.coverage;
+  j["scan_coverage"] = {{"summary", c.summary},
+                        {"warnings", c.warnings},
+                        {"top_cuts_body", c.top.cuts_body},
+                        {"top_body_fraction", c.top.body_fraction},
+                        {"top_structures", c.top.structures},
+                        {"bottom_cuts_body", c.bottom.cuts_body},
+                        {"bottom_body_fraction", c.bottom.body_fraction},
+                        {"bottom_structures", c.bottom.structures},
+                        {"lungs_in_view", c.lungs_in_view},
+                        {"pelvis_in_view", c.pelvis_in_view},
+                        {"wall_cut_laterally", c.wall_cut_laterally},
+                        {"wall_cut_anteriorly", c.wall_cut_anteriorly}};
   j["nodes"] = s.nodes;
   j["tetrahedra"] = s.tetrahedra;
   j["springs"] = s.springs;

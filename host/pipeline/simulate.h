@@ -7,6 +7,7 @@
 #include "mesh/mesh.h"
 #include "pipeline/scene_stages.h"
 #include "roles/roles.h"
+#include "roles/scan_coverage.h"
 #include "scene/scene.h"
 #include "solve/solver.h"
 
@@ -29,6 +30,7 @@ struct GravityCompensation {
 
 struct Simulation {
   RoleVolume roles;
+  ScanCoverage coverage;                      // what the CT covers, in words (roles/scan_coverage.h)
   Mesh mesh;                                  // at the CT's shape: displacements are from it
   GravityCompensation gravity;
   SolveResult result;                         // at the scene's load.pressure_mmhg

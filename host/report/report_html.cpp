@@ -106,6 +106,19 @@ void array_table(const std::string& key, const json& arr, std::ostringstream& o)
   o << "</table>\n";
 }
 
+/// What the CT covers (metrics.json "scan_coverage"), with what it misses in red.
+void coverage(const json& m, std::ostringstream& o) {
+  if (!m.is_object() || !m.contains("scan_coverage")) return;
+  const json& c = m["scan_coverage"];
+  if (!c.is_object()) return;
+  if (c.contains("summary") && c["summary"].is_string()) o << "<p>" << escape_markup(c["summary"].get<std::string>()) << "</p>\n";
+  if (c.contains("warnings") && c["warnings"].is_array() && !c["warnings"].empty()) {
+    o << "<ul class=\"warn\">";
+    for (const json& w : c["warnings"]) o << "<li>" << escape_markup(w.is_string() ? w.get<std::string>() : w.dump()) << "</li>";
+    o << "</ul>\n";
+  }
+}
+
 void summary(const json& m, std::ostringstream& o) {
   if (!m.is_object()) return;
   if (m.contains("converged")) {
@@ -297,6 +310,7 @@ std::string report_html(const ReportContent& c) {
   o << "<h1>" << escape_markup(c.title) << "</h1>\n";
   if (!c.description.empty()) o << "<p>" << escape_markup(c.description) << "</p>\n";
   summary(c.metrics, o);
+  coverage(c.metrics, o);
   if (!c.views.empty()) {
     o << "<h2>Views</h2>\n";
     for (const ReportImage& v : c.views) figure(v, o);
