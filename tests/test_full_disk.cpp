@@ -67,9 +67,10 @@ TEST(FullDisk, AWarpThatFailsAfterItsFirstImagesRemovesThemAndCanBeRunAgain) {
   ASSERT_EQ(run_pneumo("-q simulate " + scene + " --out " + d.file("out")).code, 0);
   ASSERT_EQ(run_pneumo("-q simulate " + scene + " --out " + d.file("probe")).code, 0);
   ASSERT_EQ(run_pneumo("-q warp " + scene + " --out " + d.file("probe")).code, 0);
-  // A per-file limit that the two NIfTIs fit under and the slices PNG does not.
-  const uint64_t largest_nifti = std::max(file_bytes(d, "probe/deformed_ct.nii.gz"), file_bytes(d, "probe/deformed_labels.nii.gz"));
-  const int kib = int(largest_nifti / 1024 + 2);
+  // A per-file limit that the two NIfTIs and metrics.json fit under and the slices PNG does not.
+  const uint64_t largest = std::max({file_bytes(d, "probe/deformed_ct.nii.gz"), file_bytes(d, "probe/deformed_labels.nii.gz"),
+                                     file_bytes(d, "probe/metrics.json")});
+  const int kib = int(largest / 1024 + 2);
   ASSERT_GT(file_bytes(d, "probe/slices_before_after.png"), uint64_t(kib) * 1024) << "the case no longer separates them";
   const std::string metrics_before = slurp(d.file("out/metrics.json"));
   const auto before = tree(d.path() / "out");
@@ -84,7 +85,7 @@ TEST(FullDisk, AWarpThatFailsAfterItsFirstImagesRemovesThemAndCanBeRunAgain) {
   // Replacing a finished warp (--force) that fails leaves no warp, not the old metrics over new images.
   const CliResult forced = run_pneumo_with_file_limit(kib, "-q warp " + scene + " --out " + d.file("out") + " --force");
   EXPECT_EQ(forced.code, 1) << forced.err;
-  EXPECT_FALSE(fs::exists(d.file("out/deformed_ct.nii.gz")));
+  EXPECT_FALSE(fs::exists(d.file("out/deformed_ct.nii.gz"))) << forced.err;
   EXPECT_FALSE(nlohmann::json::parse(slurp(d.file("out/metrics.json"))).contains("warp")) << "still marked as warped";
   EXPECT_EQ(run_pneumo("-q warp " + scene + " --out " + d.file("out")).code, 0);
 }
