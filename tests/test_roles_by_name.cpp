@@ -115,3 +115,14 @@ TEST(RolesByName, TheExampleRenumberedToTotalSegmentatorV1GetsTheSameRoles) {
   EXPECT_NEAR(vb[std::size_t(Role::Viscera)], va[std::size_t(Role::Viscera)], 0.01 * va[std::size_t(Role::Viscera)]);
   EXPECT_NEAR(vb[std::size_t(Role::Wall)], va[std::size_t(Role::Wall)], 0.05 * va[std::size_t(Role::Wall)]);
 }
+
+TEST(RolesByName, LabelsModeKeepsItsListsButItsMessagesNameTheStructures) {
+  PNEUMO_REQUIRE_REAL_CT();
+  nlohmann::json j = inputs_only(example_labels_path());
+  j["roles"] = {{"source", "labels"}, {"viscera_labels", {5}}, {"wall_labels", {2}}};
+  const Scene s = scene_of(j);
+  EXPECT_EQ(s.roles.viscera_labels, std::vector<int>{5});   // no lists added by name
+  EXPECT_EQ(s.roles.wall_labels, std::vector<int>{2});
+  EXPECT_TRUE(s.mesh.attached_labels.empty());
+  EXPECT_EQ(s.roles.label_names.at(5), "liver");
+}

@@ -345,7 +345,8 @@ void check_port(const Port& p, const At& at);
 /// Cross-key rules the table cannot express (scene_validate.cpp): a label in two role lists,
 /// ROI corners, port targets, unique view names, camera geometry.
 void validate_scene(const Scene& s, const ReadContext& ctx);
-/// Roles by anatomy (scene_roles_by_name.cpp): with roles.source "auto", roles.by_name and a label map
+/// The label map's names into roles.label_names, for messages, whatever the source. Then roles by anatomy
+/// (scene_roles_by_name.cpp): with roles.source "auto", roles.by_name and a label map
 /// whose ids have names (inputs.label_names, else the map's own NIfTI header), the ids no list of the
 /// scene names join the lists their structure's name gives (roles/structure_names.h), and so do
 /// roles.auto_prevesical_labels and mesh.attached_labels where `given` (the scene's JSON) lacks them.

@@ -56,17 +56,20 @@ namespace scene_detail {
 
 void assign_roles_by_name(Scene& s, const nlohmann::json& given) {
   RoleRules& r = s.roles;
-  if (r.source != RoleSource::Auto || !r.by_name || !r.auto_use_labels || s.inputs.labels.empty()) return;
+  if (s.inputs.labels.empty()) return;
   // Parsing does not need the files; a missing one is refused where it is read, with its own message.
   const std::string& names_file = s.inputs.label_names.empty() ? s.inputs.labels : s.inputs.label_names;
   if (!exists(names_file)) return;
-  r.label_names = scene_label_names(s);
-  if (r.label_names.empty()) {
+  r.label_names = scene_label_names(s);   // the messages name structures in every mode
+  if (r.source != RoleSource::Auto || !r.by_name || !r.auto_use_labels) return;
+  const bool scene_lists = !r.wall_labels.empty() || !r.viscera_labels.empty() || !r.fixed_labels.empty();
+  if (r.label_names.empty() && !scene_lists) {
     log::warn("roles: the label map's ids have no names (no inputs.label_names, none in " + s.inputs.labels +
               "'s header), so no label decides a role: the CT's HU rules decide every voxel. Give inputs.label_names "
               "(data/label_tables/ has TotalSegmentator's) or list the ids in roles.*_labels");
     return;
   }
+  if (r.label_names.empty()) return;
   std::vector<int> listed;
   for (const auto* l : {&r.wall_labels, &r.viscera_labels, &r.fixed_labels, &r.other_labels})
     listed.insert(listed.end(), l->begin(), l->end());
