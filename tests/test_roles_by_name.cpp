@@ -126,3 +126,29 @@ TEST(RolesByName, LabelsModeKeepsItsListsButItsMessagesNameTheStructures) {
   EXPECT_TRUE(s.mesh.attached_labels.empty());
   EXPECT_EQ(s.roles.label_names.at(5), "liver");
 }
+
+TEST(RolesByName, ArterialContrastInTheNamedVesselsAndOrgansChangesNoRole) {
+  // The contrast case: on an arterial-phase CT the aorta reads 350-450 HU and the kidneys' cortex
+  // and the spleen enhance, above the 250 HU bone rule. Structures the label map names keep the role of
+  // their name whatever their HU; the aorta, IVC, portal and iliac vessels raised to 400 HU, the kidneys
+  // and spleen to 260 HU, must leave every voxel's role as it was.
+  PNEUMO_REQUIRE_REAL_CT();
+  Progress::set_enabled(false);
+  const Volume ct = read_volume(example_ct_path());
+  const Volume labels = read_volume(example_labels_path());
+  Volume arterial(ct.geometry(), VoxelType::Float32);
+  int64_t raised = 0;
+  for (int64_t n = 0; n < ct.voxel_count(); ++n) {
+    const int id = int(labels.value(n));
+    float hu = float(ct.value(n));
+    if (id == 52 || (id >= 63 && id <= 68)) hu = 400.0f;     // aorta, IVC, portal/splenic and iliac vessels
+    else if (id == 1 || id == 2 || id == 3) hu = 260.0f;     // spleen, kidneys
+    raised += hu != float(ct.value(n));
+    arterial.data<float>()[n] = hu;
+  }
+  ASSERT_GT(raised, 10000);
+  const Scene s = scene_of(inputs_only(example_labels_path()));
+  const RoleVolume before = assign_roles(s, ct, &labels);
+  const RoleVolume after = assign_roles(s, arterial, &labels);
+  EXPECT_TRUE(before.role == after.role);
+}

@@ -168,7 +168,9 @@ void attach_below_the_reflection(std::vector<Role>& role, const uint16_t* label,
                    [&](int64_t s, int64_t) { return back[std::size_t(s)]; });
 }
 
-/// Rule 6: undecided voxels lateral to bone (away from the midline) → fixed.
+/// Rule 6: undecided voxels lateral to bone (away from the midline) → fixed. Bone here is what rules
+/// 1 and 3 fixed above the bone threshold: a labelled vessel or organ that enhances above it (an
+/// arterial-phase aorta, iliac arteries, kidneys) keeps its label's role and anchors nothing.
 void fix_lateral_to_bone(std::vector<Role>& role, const std::vector<uint8_t>& body, const float* hu,
                          const std::vector<SliceCentre>& centres, const SliceFrame& f, const RoleRules& r) {
   const int64_t n = int64_t(role.size());
@@ -176,7 +178,7 @@ void fix_lateral_to_bone(std::vector<Role>& role, const std::vector<uint8_t>& bo
   const float bone_hu = float(r.auto_bone_threshold_hu);
 #pragma omp parallel for schedule(static)
   for (int64_t v = 0; v < n; ++v) {
-    bone[v] = body[v] && hu[v] > bone_hu;
+    bone[v] = body[v] && hu[v] > bone_hu && role[v] == Role::Fixed;
     undecided[v] = role[v] == kUndecided;
   }
   const std::vector<uint8_t> lateral = lateral_to_bone(bone, undecided, centres, f);
