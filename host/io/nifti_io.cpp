@@ -291,6 +291,28 @@ Volume read_nifti(const std::string& path) {
   return v;
 }
 
+NiftiExtensions read_nifti_extensions(const std::string& path) {
+  quiet_niftilib();
+  require_regular_file(path);
+  NiftiExtensions out;
+  const nifti_1_header raw = read_checked_header(path, &out.swapped);
+  nifti_1_header h = raw;
+  if (out.swapped) nifti_swap_as_nifti1(&h);
+  // The 4 bytes after the header: extension[0] != 0 when extensions follow, up to vox_offset.
+  constexpr uint64_t kMaxExtensionBytes = 16u << 20;   // 65,536 long label names fit in far less
+  const uint64_t end = uint64_t(h.vox_offset);
+  if (end <= 352) return out;
+  if (end - 352 > kMaxExtensionBytes)
+    throw file_error(path, "header extensions of " + std::to_string(end - 352) + " bytes (at most 16 MB are read)");
+  GzPtr f = open_for_reading(path);
+  std::string head(352, '\0');
+  if (read_bytes(path, f.get(), head.data(), 352) != 352 || head[348] == 0) return out;
+  out.bytes.resize(end - 352);
+  if (read_bytes(path, f.get(), out.bytes.data(), out.bytes.size()) != out.bytes.size())
+    throw file_error(path, "truncated: the header extensions end before vox_offset");
+  return out;
+}
+
 namespace {
 
 /// Writes `data` (`payload` bytes, NIfTI order) under the header `dims` and `datatype` describe, on

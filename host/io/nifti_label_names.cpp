@@ -2,30 +2,20 @@
 // them as a Caret-style XML label table in an extension (code 0) after the 348-byte header:
 //   <LabelTable> <Label Key="5" Red=… Alpha="1"><![CDATA[liver]]></Label> … </LabelTable>
 // so a multi-label map is self-describing and a scene needs no separate names file. Only the bytes
-// between the header and the voxels (vox_offset) are read. The table is read with a few string
+// between the header and the voxels are read (read_nifti_extensions). The table is read with a few string
 // searches, not an XML library: pneumo reads one element type whose attributes it needs one of, and
 // a malformed table is refused, not repaired.
-#include <zlib.h>
-
 #include <cstdint>
 #include <cstring>
-#include <memory>
 #include <string>
 
 #include "core/error.h"
-#include "core/input_file.h"
 #include "io/label_table.h"
+#include "io/volume_io.h"
 
 namespace pneumo {
 
 namespace {
-
-// The extensions of a label map with 65,536 long names fit in well under this.
-constexpr uint64_t kMaxExtensionBytes = 16u << 20;
-
-struct GzCloser {
-  void operator()(gzFile f) const { if (f) gzclose_r(f); }
-};
 
 uint32_t swap32(uint32_t v) { return (v >> 24) | ((v >> 8) & 0xff00u) | ((v << 8) & 0xff0000u) | (v << 24); }
 
@@ -33,15 +23,6 @@ int32_t read_i32(const unsigned char* p, bool swapped) {
   uint32_t v;
   std::memcpy(&v, p, 4);
   return int32_t(swapped ? swap32(v) : v);
-}
-
-float read_f32(const unsigned char* p, bool swapped) {
-  uint32_t v;
-  std::memcpy(&v, p, 4);
-  if (swapped) v = swap32(v);
-  float f;
-  std::memcpy(&f, &v, 4);
-  return f;
 }
 
 /// Names from one extension's text; empty when it holds no <LabelTable>.
@@ -81,24 +62,10 @@ std::map<int, std::string> names_from_label_table(const std::string& text, const
 }  // namespace
 
 std::map<int, std::string> read_nifti_label_names(const std::string& path) {
-  InputFile file(path, "the label map");
-  std::unique_ptr<gzFile_s, GzCloser> f(gzdopen(file.fd(), "rb"));
-  if (!f) throw file_error(path, "cannot open: " + std::string(std::strerror(errno)));
-  file.release();
-  unsigned char head[352];
-  if (gzread(f.get(), head, sizeof head) != int(sizeof head)) return {};   // too short for extensions
-  bool swapped = false;
-  if (read_i32(head, false) != 348) {
-    if (read_i32(head, true) != 348) return {};   // not NIfTI-1: read_nifti says why when the volume is read
-    swapped = true;
-  }
-  if (std::memcmp(head + 344, "n+1", 4) != 0 || head[348] == 0) return {};   // no extension flag
-  const float vox_offset = read_f32(head + 108, swapped);
-  if (!(vox_offset > 352.0f) || vox_offset > float(kMaxExtensionBytes)) return {};
-  const uint64_t n = uint64_t(vox_offset) - 352;
-  std::string ext(n, '\0');
-  if (uint64_t(gzread(f.get(), ext.data(), unsigned(n))) != n)
-    throw file_error(path, "truncated: the header extensions end before vox_offset");
+  const NiftiExtensions e = read_nifti_extensions(path);
+  const std::string& ext = e.bytes;
+  const bool swapped = e.swapped;
+  const uint64_t n = ext.size();
   // NIfTI-1 extensions: esize (a multiple of 16, including its 8-byte head), ecode, then the data.
   for (uint64_t at = 0; at + 8 <= n;) {
     const int32_t esize = read_i32(reinterpret_cast<const unsigned char*>(ext.data() + at), swapped);

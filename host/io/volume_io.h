@@ -34,6 +34,14 @@ std::string metaimage_data_path(const std::string& mhd_path, bool compressed);
 
 // Per-format entry points (used by the dispatchers above and by tests).
 Volume read_nifti(const std::string& path);
+/// The bytes of a NIfTI-1 file's header extensions (from byte 352 to vox_offset; empty when its
+/// extension flag is 0) and whether the file's byte order is swapped. The header is checked as
+/// read_nifti checks it.
+struct NiftiExtensions {
+  std::string bytes;
+  bool swapped = false;
+};
+NiftiExtensions read_nifti_extensions(const std::string& path);
 void write_nifti(const Volume& v, const std::string& path);
 Volume read_metaimage(const std::string& path);
 void write_metaimage(const Volume& v, const std::string& path, bool compress);
