@@ -9,6 +9,7 @@
 #include "example_roles_support.h"
 #include "io/volume_io.h"
 #include "roles/auto_pad.h"
+#include "roles/body_mask.h"
 
 using namespace pneumo;
 
@@ -38,14 +39,17 @@ Volume body_ct(const Vec3& centre_mm, const Mat3& direction = Mat3::Identity()) 
   return v;
 }
 
-BodyClearance clearance_of(const Volume& ct) {
-  const Volume f = [&] {
-    Volume out(ct.geometry(), VoxelType::Float32);
-    for (int64_t n = 0; n < ct.voxel_count(); ++n) out.data<float>()[n] = float(ct.value(n));
-    return out;
-  }();
-  return body_clearance(f.data<float>(), ct.geometry(), -500.0);
+/// The CT's HU as float32, as the roles read them.
+Volume as_float(const Volume& ct) {
+  Volume out(ct.geometry(), VoxelType::Float32);
+  for (int64_t n = 0; n < ct.voxel_count(); ++n) out.data<float>()[n] = float(ct.value(n));
+  return out;
 }
+
+/// The body of a CT as the automatic roles find it.
+std::vector<uint8_t> body_of(const Volume& ct) { return body_mask(as_float(ct).data<float>(), ct.geometry(), -500.0); }
+
+BodyClearance clearance_of(const Volume& ct) { return body_clearance(body_of(ct), ct.geometry()); }
 
 }  // namespace
 
@@ -73,24 +77,22 @@ TEST(AutoPad, AnLpsGridMeasuresTheSameSides) {
 
 TEST(AutoPad, OnlySidesTheSceneLeavesUnsetAndTooCloseArePadded) {
   const Volume ct = body_ct(Vec3(30, 40, 0));   // anterior 10 mm, right 40 mm, left 100 mm
-  Volume f(ct.geometry(), VoxelType::Float32);
-  for (int64_t n = 0; n < ct.voxel_count(); ++n) f.data<float>()[n] = float(ct.value(n));
+  const std::vector<uint8_t> body = body_of(ct);
   RoleRules r;
   r.source = RoleSource::Auto;
-  PadMm p = resolved_pad_mm(r, f.data<float>(), ct.geometry());
+  PadMm p = resolved_pad_mm(r, &body, ct.geometry());
   EXPECT_EQ(p.anterior, kAutoPadMm);
   EXPECT_EQ(p.lateral, kAutoPadMm);   // the right side is 40 mm from its edge
   r.pad_lateral_mm = 0.0;             // the scene's word wins, 0 included
-  p = resolved_pad_mm(r, f.data<float>(), ct.geometry());
+  p = resolved_pad_mm(r, &body, ct.geometry());
   EXPECT_EQ(p.anterior, kAutoPadMm);
   EXPECT_EQ(p.lateral, 0.0);
   // Room enough everywhere: nothing added.
   const Volume roomy = body_ct(Vec3(0, -45, 0));   // anterior 95 mm, sides 70 mm
-  Volume g(roomy.geometry(), VoxelType::Float32);
-  for (int64_t n = 0; n < roomy.voxel_count(); ++n) g.data<float>()[n] = float(roomy.value(n));
+  const std::vector<uint8_t> roomy_body = body_of(roomy);
   RoleRules automatic;
   automatic.source = RoleSource::Auto;
-  p = resolved_pad_mm(automatic, g.data<float>(), roomy.geometry());
+  p = resolved_pad_mm(automatic, &roomy_body, roomy.geometry());
   EXPECT_EQ(p.anterior, 0.0);
   EXPECT_EQ(p.lateral, 0.0);
   // Labels describe every voxel, air included: nothing is found or added.

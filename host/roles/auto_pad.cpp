@@ -5,12 +5,10 @@
 
 #include "core/log.h"
 #include "roles/anatomical_axes.h"
-#include "roles/body_mask.h"
 
 namespace pneumo {
 
-BodyClearance body_clearance(const float* hu, const Geometry& g, double body_threshold_hu) {
-  const std::vector<uint8_t> body = body_mask(hu, g, body_threshold_hu);
+BodyClearance body_clearance(const std::vector<uint8_t>& body, const Geometry& g) {
   const SliceFrame f = slice_frame(g);
   const AnatomicalAxes ax = anatomical_axes(g);
   int64_t most_anterior = -1, lat_lo = f.n_lat, lat_hi = -1;
@@ -33,11 +31,12 @@ BodyClearance body_clearance(const float* hu, const Geometry& g, double body_thr
   return c;
 }
 
-PadMm resolved_pad_mm(const RoleRules& r, const float* hu, const Geometry& g) {
+PadMm resolved_pad_mm(const RoleRules& r, const std::vector<uint8_t>* body, const Geometry& g) {
   PadMm p{r.pad_anterior_mm.value_or(0.0), r.pad_lateral_mm.value_or(0.0), r.pad_superior_mm, r.pad_inferior_mm};
   // roles.source "labels" describes every voxel itself, its air included (the phantoms): nothing is added.
   if ((r.pad_anterior_mm && r.pad_lateral_mm) || r.source != RoleSource::Auto) return p;
-  const BodyClearance c = body_clearance(hu, g, r.auto_body_threshold_hu);
+  if (!body) return p;
+  const BodyClearance c = body_clearance(*body, g);
   if (!r.pad_anterior_mm && c.anterior_mm < kAutoPadMm) p.anterior = kAutoPadMm;
   if (!r.pad_lateral_mm && std::min(c.right_mm, c.left_mm) < kAutoPadMm) p.lateral = kAutoPadMm;
   if (p.anterior > 0 || p.lateral > 0)

@@ -6,7 +6,10 @@
 // is padded by kAutoPadMm when the body comes closer than that to the grid's edge on it, and not at
 // all otherwise. One fixed amount, not a top-up to it: the anatomy then sits at the same place in
 // the padded grid's lattice (a whole number of voxels) whatever air the scan had.
-#include "io/volume.h"
+#include <cstdint>
+#include <vector>
+
+#include "core/geometry.h"
 #include "roles/pad.h"
 #include "roles/role_rules.h"
 
@@ -15,16 +18,16 @@ namespace pneumo {
 inline constexpr double kAutoPadMm = 60.0;
 
 /// The body's distance to the grid's edge on each side (mm): anterior, the patient's right and left.
-/// The body as the automatic roles see it (roles/body_mask.h: above auto_body_threshold_hu, largest part).
+/// `body` as the automatic roles see it (roles/body_mask.h), on grid `g`.
 struct BodyClearance {
   double anterior_mm = 0.0, right_mm = 0.0, left_mm = 0.0;
 };
-BodyClearance body_clearance(const float* hu, const Geometry& g, double body_threshold_hu);
+BodyClearance body_clearance(const std::vector<uint8_t>& body, const Geometry& g);
 
 /// The padding of a case: the scene's where it gives one, else, with roles.source "auto", kAutoPadMm on
 /// a side whose clearance is below it (lateral: either side); "labels" describes every voxel itself,
-/// its air included (the phantoms), and gets none. `hu` is the CT on its own grid (may be null when
+/// its air included (the phantoms), and gets none. `body` is on the CT's own grid (may be null when
 /// nothing is to be found: both sides given, or source "labels").
-PadMm resolved_pad_mm(const RoleRules& rules, const float* hu, const Geometry& g);
+PadMm resolved_pad_mm(const RoleRules& rules, const std::vector<uint8_t>* body, const Geometry& g);
 
 }  // namespace pneumo

@@ -189,12 +189,15 @@ void fix_lateral_to_bone(std::vector<Role>& role, const std::vector<uint8_t>& bo
 
 }  // namespace
 
-std::vector<Role> auto_roles(const RoleRules& r, const Geometry& g, const float* hu, const uint16_t* label) {
+std::vector<Role> auto_roles(const RoleRules& r, const Geometry& g, const float* hu, const uint16_t* label,
+                             const std::vector<uint8_t>* given_body) {
   Progress progress("roles", 6);
   StageTimer timer(progress);
   const SliceFrame f = slice_frame(g);
 
-  const std::vector<uint8_t> body = body_mask(hu, g, r.auto_body_threshold_hu);
+  const bool have_body = given_body && int64_t(given_body->size()) == g.voxel_count();
+  const std::vector<uint8_t> own = have_body ? std::vector<uint8_t>() : body_mask(hu, g, r.auto_body_threshold_hu);
+  const std::vector<uint8_t>& body = have_body ? *given_body : own;
   const std::vector<SliceCentre> centres = body_centres(body, f);
   timer.done(1, "body mask");
 

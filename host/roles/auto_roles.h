@@ -56,7 +56,9 @@
 
 namespace pneumo {
 
-/// Roles on grid `g` from `hu` (HU, i fastest) and, when not null, `label` on the same grid.
-std::vector<Role> auto_roles(const RoleRules& rules, const Geometry& g, const float* hu, const uint16_t* label);
+/// Roles on grid `g` from `hu` (HU, i fastest) and, when not null, `label` on the same grid. `body`, when
+/// given, is body_mask's result on this grid (assign_roles finds it once for the padding too).
+std::vector<Role> auto_roles(const RoleRules& rules, const Geometry& g, const float* hu, const uint16_t* label,
+                             const std::vector<uint8_t>* body = nullptr);
 
 }  // namespace pneumo

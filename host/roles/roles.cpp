@@ -8,6 +8,7 @@
 #include "io/volume_io.h"
 #include "roles/auto_pad.h"
 #include "roles/auto_roles.h"
+#include "roles/body_mask.h"
 #include "roles/label_map.h"
 
 namespace pneumo {
@@ -122,21 +123,25 @@ RoleVolume assign_roles(const RoleRules& rules, const Volume& ct, const Volume* 
     check_label_values(*labels, names.labels);
   }
   RoleVolume rv;
-  rv.pad = pad_voxels(ct.geometry(), [&] {
-    if ((rules.pad_anterior_mm && rules.pad_lateral_mm) || rules.source != RoleSource::Auto)
-      return resolved_pad_mm(rules, nullptr, ct.geometry());
-    const Volume hu = padded_ct_float(ct, PadVoxels{});   // the HU as floats, freed before the padded copy
-    return resolved_pad_mm(rules, hu.data<float>(), ct.geometry());
-  }());
+  // The automatic rules' body, found once on the CT's own grid: it places the padding (auto_pad.h),
+  // then, padded with outside, serves the rules. Air around a slice changes neither its largest part
+  // nor which background reaches the slice's border, so it is the body the padded grid would give.
+  std::vector<uint8_t> body;
+  if (rules.source == RoleSource::Auto) {
+    const Volume hu = padded_ct_float(ct, PadVoxels{});   // freed before the padded copy
+    body = body_mask(hu.data<float>(), ct.geometry(), rules.auto_body_threshold_hu);
+  }
+  rv.pad = pad_voxels(ct.geometry(), resolved_pad_mm(rules, body.empty() ? nullptr : &body, ct.geometry()));
   rv.geometry = padded_geometry(ct.geometry(), rv.pad);
   rv.ct = padded_ct_float(ct, rv.pad);
   rv.label = padded_labels(labels, ct.geometry(), rv.pad);
+  if (!body.empty()) body = pad_array<uint8_t>(body.data(), ct.geometry().dims, rv.pad, uint8_t(0));
   if (labels) note_label_coverage(rules, rv.label, names.labels);
 
   if (rules.source == RoleSource::Labels) {
     rv.role = roles_from_labels(rv.label, rules.label_roles());
   } else {
-    rv.role = auto_roles(rules, rv.geometry, rv.ct.data<float>(), labels ? rv.label.data() : nullptr);
+    rv.role = auto_roles(rules, rv.geometry, rv.ct.data<float>(), labels ? rv.label.data() : nullptr, &body);
   }
   return rv;
 }
