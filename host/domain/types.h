@@ -16,6 +16,8 @@ namespace pneumo {
 enum class Role : uint8_t { Other = 0, Wall = 1, Viscera = 2, Fixed = 3 };
 enum class RoleSource : uint8_t { Labels, Auto };
 enum class MeshModel : uint8_t { WallViscera, Wall };
+/// Where the CT's grid cuts the body cranially or caudally (mesh.h: MeshOptions::cut_faces).
+enum class CutFaces : uint8_t { Slide, Free };
 enum class SpringModel : uint8_t { Nonlinear, Linear };
 /// The material model on the tetrahedra: the springs of §4–5 or finite elements (solve/fem_element.h).
 enum class MaterialModel : uint8_t { Msd, FemCorotational, FemNeoHookean };
@@ -47,6 +49,9 @@ template <> struct EnumNames<RoleSource> {
 };
 template <> struct EnumNames<MeshModel> {
   static constexpr std::array<const char*, 2> names{"wall_viscera", "wall"};
+};
+template <> struct EnumNames<CutFaces> {
+  static constexpr std::array<const char*, 2> names{"slide", "free"};
 };
 template <> struct EnumNames<SpringModel> {
   static constexpr std::array<const char*, 2> names{"nonlinear", "linear"};

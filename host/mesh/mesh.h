@@ -63,6 +63,12 @@ struct MeshOptions {
   /// extraperitoneal organs the viscera lie on): no gas pressure on those voxel faces, and their
   /// nodes marked in Mesh::node_attached for the bond of solve/interface_tie.h.
   std::vector<int> attached_labels;
+  /// The faces where the grid cuts the body across its long axis (a scan that stops at the liver or at
+  /// L3): Slide holds their nodes on the cut plane's normal (world z) and leaves them free within it,
+  /// as a symmetry plane does: the body beyond is taken as the mirror image of the body inside, so
+  /// the wall's cut edge neither lifts like a flap nor lets the viscera out (docs/fidelity.md, "Cut
+  /// faces"). Free leaves them free, as a real edge of tissue would be.
+  CutFaces cut_faces = CutFaces::Slide;
 };
 
 struct Mesh;
@@ -103,6 +109,7 @@ struct ContactFaces {
 
 struct MeshStats {
   int64_t nodes = 0, tetrahedra = 0, springs = 0, fixed_nodes = 0;
+  int64_t cut_face_nodes = 0;      // nodes held on a cut face's normal only (MeshOptions::cut_faces)
   int64_t cavity_faces = 0;        // voxel faces between wall and viscera, both sides counted
   int64_t attached_faces = 0;      // of those, the ones of an attached label (no gas), both sides
   int64_t pressure_tetrahedra = 0; // tetrahedra carrying some of them

@@ -177,6 +177,30 @@ bool touches_fixed(const VoxelRoles& roles, int64_t a, int64_t b, int64_t c, con
   return false;
 }
 
+/// The grid axis that crosses the body's long axis (the one nearest world z), or -1 where it leans
+/// from world z by more than 1° (a tilted gantry): a node's holds are world axes, so a cut plane
+/// oblique to them cannot be held on its normal alone, and its faces stay free.
+int cut_axis(const Geometry& g) {
+  int k = 0;
+  for (int a = 1; a < 3; ++a)
+    if (std::abs(g.direction(2, a)) > std::abs(g.direction(2, k))) k = a;
+  return std::abs(g.direction(2, k)) >= std::cos(1.0 * 3.14159265358979323846 / 180.0) ? k : -1;
+}
+
+/// Whether the grid's end slice `slice` along `axis` holds tissue (any role but other) in the cubes
+/// around the lattice node `n` on that end: the grid cuts the body there.
+bool cut_through_tissue(const VoxelRoles& roles, const std::array<int64_t, 3>& n, int axis, int64_t slice,
+                        const CubeVoxels& L) {
+  const Geometry& g = roles.geometry;
+  const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+  std::array<int64_t, 3> v{};
+  v[axis] = slice;
+  for (v[w] = std::max<int64_t>(0, (n[w] - 1) * L[w]); v[w] < std::min(g.dims[w], (n[w] + 1) * L[w]); ++v[w])
+    for (v[u] = std::max<int64_t>(0, (n[u] - 1) * L[u]); v[u] < std::min(g.dims[u], (n[u] + 1) * L[u]); ++v[u])
+      if (roles.role[g.linear_index(v[0], v[1], v[2])] != Role::Other) return true;
+  return false;
+}
+
 /// The face of voxel (i,j,k) on its `side` (±1) along `axis`: its centre in index space, and in world
 /// metres with its area vector (m²) out of the voxel.
 struct VoxelFace {
@@ -686,6 +710,22 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
           if (node_id[p][ni] >= 0) m.hold[node_id[p][ni]] = kHoldAll;
       }
 
+  // Cut faces: the lattice's end planes along the body's long axis where the grid's end slice cuts
+  // tissue; held on world z, free in the plane (MeshOptions::cut_faces).
+  const int axis = opt.cut_faces == CutFaces::Slide ? cut_axis(g) : -1;
+  if (axis >= 0)
+    for (int64_t c = 0; c <= lat.cubes[2]; ++c)
+      for (int64_t b = 0; b <= lat.cubes[1]; ++b)
+        for (int64_t a = 0; a <= lat.cubes[0]; ++a) {
+          const std::array<int64_t, 3> n{a, b, c};
+          if (n[axis] != 0 && n[axis] != lat.cubes[axis]) continue;
+          const int64_t ni = lat.node_index(a, b, c);
+          if (node_id[0][ni] < 0 && node_id[1][ni] < 0) continue;
+          if (!cut_through_tissue(roles, n, axis, n[axis] == 0 ? 0 : g.dims[axis] - 1, L)) continue;
+          for (int p = 0; p < kParts; ++p)
+            if (node_id[p][ni] >= 0) m.hold[node_id[p][ni]] |= kHoldZ;
+        }
+
   const AttachedLabels attached(opt.attached_labels);
   build_pressure_loads(m, roles, lat, L, meshed, first_tet, attached);
   mark_attached_nodes(m, roles, L, node_id, lat, attached);
@@ -718,6 +758,7 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
   m.stats.springs = int64_t(m.springs.size());
   for (int64_t i = 0; i < N; ++i) {
     m.stats.fixed_nodes += m.hold[i] == kHoldAll;
+    m.stats.cut_face_nodes += m.hold[i] == kHoldZ;
     ++(m.node_part[i] == Part::Wall ? m.stats.wall_nodes : m.stats.viscera_nodes);
   }
   return m;

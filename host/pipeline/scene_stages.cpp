@@ -45,6 +45,7 @@ Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene, bool to_solve
   opt.roi_min_mm = scene.mesh.roi_min_mm;
   opt.roi_max_mm = scene.mesh.roi_max_mm;
   opt.attached_labels = scene.mesh.attached_labels;
+  opt.cut_faces = scene.mesh.cut_faces;
   if (to_solve) {
     const SolveFootprint solver = solve_host_footprint(solve_options_from_scene(scene));
     opt.reserve_bytes_per_node = solver.per_node;

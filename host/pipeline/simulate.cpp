@@ -64,6 +64,7 @@ Simulation prepare_simulation(const Scene& scene, bool keep_inputs) {
      << edge_mm[2] << " mm), " << s.nodes << " nodes, " << s.tetrahedra << " tetrahedra, " << s.springs << " springs, "
      << s.cavity_faces << " cavity faces, " << s.fixed_nodes << " fixed nodes, " << s.doubled_cubes
      << " doubled cubes";
+  if (s.cut_face_nodes > 0) os << ", " << s.cut_face_nodes << " nodes sliding on the CT's cut faces";
   log::info(os.str());
   // Before starting a device: nothing free, or a part the load would carry away.
   check_solvable(sim.mesh, solve_options_from_scene(scene), "scene " + scene.path);
@@ -245,6 +246,7 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   j["cavity_faces"] = s.cavity_faces;
   j["pressure_tetrahedra"] = s.pressure_tetrahedra;
   j["fixed_nodes"] = s.fixed_nodes;
+  j["cut_face_nodes"] = s.cut_face_nodes;
   j["wall_cubes"] = s.wall_cubes;
   j["viscera_cubes"] = s.viscera_cubes;
   j["doubled_cubes"] = s.doubled_cubes;

@@ -54,6 +54,7 @@ constexpr Entry kEntries[] = {
     {"springs", "Springs", "", "Model", 1},
     {"pressure_tetrahedra", "Tetrahedra carrying pressure", "", "Model", 1},
     {"fixed_nodes", "Fixed nodes", "", "Model", 1},
+    {"cut_face_nodes", "Nodes sliding on the CT's cut faces (mesh.cut_faces)", "", "Model", 1},
     {"wall_cubes", "Wall cubes", "", "Model", 1},
     {"viscera_cubes", "Viscera cubes", "", "Model", 1},
     {"doubled_cubes", "Cubes split between wall and viscera", "", "Model", 1},

@@ -100,13 +100,15 @@ ScanCoverage scan_coverage(const RoleVolume& rv, const std::map<int, std::string
     for (const std::string& s : c.top.structures)
       if (compartment_of(s) == Compartment::Peritoneal) {
         c.warnings.push_back("the top slice cuts the " + words(s) +
-                             ": the cavity's roof (the diaphragm) lies above the scan, and the cut face is free (no "
-                             "tissue beyond it holds the wall and organs there): trust the answer less near the top slice");
+                             ": the cavity's roof (the diaphragm) lies above the scan; by default the cut face "
+                             "slides in its plane (mesh.cut_faces), a diaphragm that neither rises nor gives: "
+                             "trust the answer less near the top slice");
         break;
       }
   if (!names.empty() && !c.pelvis_in_view && c.bottom.cuts_body)
     c.warnings.push_back("no pelvis in view (no hip, sacrum or bladder): the scan stops above it, the lower "
-                         "abdominal wall is cut and free at the bottom slice, and the cavity below it is missing");
+                         "abdominal wall is cut at the bottom slice (by default held there as if it continued, "
+                         "mesh.cut_faces), and the cavity below it is missing");
   if (c.wall_cut_laterally)
     c.warnings.push_back("the field of view cuts the abdominal wall at the side: the flank beyond it is missing");
   if (c.wall_cut_anteriorly)

@@ -40,6 +40,7 @@ struct SceneMesh {
   MeshModel model = MeshModel::WallViscera;
   std::optional<Vec3> roi_min_mm, roi_max_mm;  // both or neither
   std::vector<int> attached_labels;   // wall labels whose interface with the viscera stays closed
+  CutFaces cut_faces = CutFaces::Slide;   // mesh.h: MeshOptions::cut_faces
 };
 
 /// Young's modulus for one label id, overriding the role's value.

@@ -169,6 +169,11 @@ const Table<SceneMesh>& mesh_table() {
        "and the viscera, which are bonded to them there (solve/interface_tie.h). Needs solver.method \"static\", "
        "\"newton\" or \"implicit-euler\". TotalSegmentator: the example scene's wall_labels. Empty: every "
        "wall-viscera interface may open."},
+      {"cut_faces", &SceneMesh::cut_faces, "", any(),
+       "Where the CT stops across the body (cut at L3, at the liver): \"slide\" holds the cut face's nodes "
+       "cranio-caudally and leaves them free in its plane, as if the body continued beyond as its mirror image "
+       "(docs/fidelity.md, cut faces); \"free\": the cut face is a free surface, and the wall's edge lifts like "
+       "a flap. Faces of padded air are not cut faces."},
   };
   return t;
 }
