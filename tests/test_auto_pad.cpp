@@ -9,7 +9,7 @@
 #include "example_roles_support.h"
 #include "io/volume_io.h"
 #include "roles/auto_pad.h"
-#include "roles/body_mask.h"
+#include "anatomy/body_mask.h"
 
 using namespace pneumo;
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "roles/anatomical_axes.h"
+#include "anatomy/anatomical_axes.h"
 
 namespace pneumo {
 

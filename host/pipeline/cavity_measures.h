@@ -22,7 +22,7 @@ struct RestColumns {
 };
 
 /// Gas voxels (== gas_label) lying anterior to a voxel of one of `ids` in the same axial column
-/// (same slice, same lateral index; roles/anatomical_axes.h): on the deformed labels with the
+/// (same slice, same lateral index; anatomy/anatomical_axes.h): on the deformed labels with the
 /// bladder's id, gas in front of the bladder. Counts voxels; 0 when no listed id is present.
 /// With `stop_ids` (the intraperitoneal organs), the column is followed forward from the organ's
 /// front only until a voxel of one of them: gas beyond a bowel loop that lies in front of the

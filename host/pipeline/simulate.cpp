@@ -18,7 +18,7 @@
 #include "mesh/vtu_writer.h"
 #include "pipeline/cavity_measures.h"
 #include "pipeline/scene_stages.h"
-#include "roles/anatomical_axes.h"
+#include "anatomy/anatomical_axes.h"
 #include "report/plot_svg.h"
 #include "solve/gravity_compensation.h"
 #include "solve/solvable.h"

@@ -20,7 +20,7 @@
 #include "pipeline/scene_stages.h"
 #include "render/render_volume.h"
 #include "report/slices.h"
-#include "roles/connected_components.h"
+#include "anatomy/connected_components.h"
 #include "warp/cavity_specks.h"
 #include "warp/displacement_field.h"
 

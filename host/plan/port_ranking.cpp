@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 #include "plan/distance_map.h"
-#include "roles/anatomical_axes.h"
+#include "anatomy/anatomical_axes.h"
 
 namespace pneumo {
 

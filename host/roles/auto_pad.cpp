@@ -4,7 +4,7 @@
 #include <limits>
 
 #include "core/log.h"
-#include "roles/anatomical_axes.h"
+#include "anatomy/anatomical_axes.h"
 
 namespace pneumo {
 

@@ -18,7 +18,7 @@ namespace pneumo {
 inline constexpr double kAutoPadMm = 60.0;
 
 /// The body's distance to the grid's edge on each side (mm): anterior, the patient's right and left.
-/// `body` as the automatic roles see it (roles/body_mask.h), on grid `g`.
+/// `body` as the automatic roles see it (anatomy/body_mask.h), on grid `g`.
 struct BodyClearance {
   double anterior_mm = 0.0, right_mm = 0.0, left_mm = 0.0;
 };

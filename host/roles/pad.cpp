@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "roles/anatomical_axes.h"
+#include "anatomy/anatomical_axes.h"
 #include "roles/role_rules.h"
 
 namespace pneumo {

@@ -8,7 +8,7 @@
 #include "io/volume_io.h"
 #include "roles/auto_pad.h"
 #include "roles/auto_roles.h"
-#include "roles/body_mask.h"
+#include "anatomy/body_mask.h"
 #include "roles/label_map.h"
 
 namespace pneumo {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cctype>
 
-#include "roles/anatomical_axes.h"
+#include "anatomy/anatomical_axes.h"
 #include "roles/structure_names.h"
 
 namespace pneumo {

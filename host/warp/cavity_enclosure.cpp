@@ -2,8 +2,8 @@
 
 #include <vector>
 
-#include "roles/anatomical_axes.h"
-#include "roles/body_mask.h"
+#include "anatomy/anatomical_axes.h"
+#include "anatomy/body_mask.h"
 
 namespace pneumo {
 

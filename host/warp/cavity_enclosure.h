@@ -15,7 +15,7 @@
 // rule 4 would have kept at rest (no mesh there) with the role `other`, reachable from the slice's
 // border through such voxels then: tissue the roles call `other` inside the body (a label no role
 // lists) never becomes gas, and a zero displacement changes nothing. Per axial slice, as the body
-// mask's holes are filled (roles/body_mask.h): one slice's chink cannot open a whole cavity.
+// mask's holes are filled (anatomy/body_mask.h): one slice's chink cannot open a whole cavity.
 #include <cstdint>
 
 #include "domain/types.h"

@@ -1,6 +1,6 @@
-#include "roles/body_mask.h"
+#include "anatomy/body_mask.h"
 
-#include "roles/connected_components.h"
+#include "anatomy/connected_components.h"
 
 namespace pneumo {
 

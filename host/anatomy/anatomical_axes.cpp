@@ -1,4 +1,4 @@
-#include "roles/anatomical_axes.h"
+#include "anatomy/anatomical_axes.h"
 
 #include <algorithm>
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "core/geometry.h"
-#include "roles/anatomical_axes.h"
+#include "anatomy/anatomical_axes.h"
 
 namespace pneumo {
 

@@ -1,4 +1,4 @@
-#include "roles/connected_components.h"
+#include "anatomy/connected_components.h"
 
 #include <algorithm>
 #include <numeric>

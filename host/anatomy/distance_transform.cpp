@@ -1,4 +1,4 @@
-#include "roles/distance_transform.h"
+#include "anatomy/distance_transform.h"
 
 #include <cmath>
 #include <limits>

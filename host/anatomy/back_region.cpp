@@ -6,7 +6,7 @@
 // vertebra label) stop the run at the posterior elements, which the smoothing over z repairs.
 // Below the sacrum (perineum, femoral heads) the first fixed run may be a gluteal muscle or the
 // pelvic floor: the back region then stays small, which is harmless there.
-#include "roles/back_region.h"
+#include "anatomy/back_region.h"
 
 #include <algorithm>
 #include <cmath>
