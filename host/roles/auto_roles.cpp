@@ -3,18 +3,21 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "core/log.h"
 #include "core/progress.h"
 #include "domain/label_set.h"
 #include "anatomy/anatomical_axes.h"
+#include "anatomy/thorax.h"
 #include "anatomy/back_region.h"
 #include "anatomy/body_mask.h"
 #include "anatomy/distance_transform.h"
 #include "roles/label_map.h"
 #include "roles/lateral_to_bone.h"
 #include "roles/role_rules.h"
+#include "roles/structure_names.h"
 
 namespace pneumo {
 
@@ -60,6 +63,68 @@ std::vector<Role> decide_by_labels_and_hu(const RoleRules& r, const std::vector<
   return role;
 }
 
+/// Rule 3b: the chest above the diaphragm (anatomy/thorax.h): its lungs, and what lies deeper than
+/// the wall's shell (the heart, the mediastinum), fixed; the chest wall is left to the shell rule, as
+/// where the lungs and heart are labelled. Returns what is held (labelled lungs and heart included):
+/// rule 5c's diaphragm lies under it.
+std::vector<uint8_t> fix_the_chest(std::vector<Role>& role, const RoleRules& r, const Geometry& g, const float* hu,
+                                   const uint16_t* label, const std::vector<uint8_t>& body,
+                                   const std::vector<float>& depth_mm) {
+  const int64_t n = int64_t(role.size());
+  std::vector<uint8_t> labelled;
+  if (r.auto_use_labels && label) {
+    std::vector<uint8_t> chest_id(65536, 0);
+    bool any = false;
+    for (const auto& [id, name] : r.label_names)
+      if (id > 0 && id < 65536 && lies_above_the_diaphragm(name)) {
+        chest_id[std::size_t(id)] = 1;
+        any = true;
+      }
+    if (any) {
+      labelled.resize(static_cast<std::size_t>(n));
+#pragma omp parallel for schedule(static)
+      for (int64_t v = 0; v < n; ++v) labelled[v] = chest_id[label[v]];
+    }
+  }
+  const Thorax t = find_thorax(hu, body, g, labelled.empty() ? nullptr : &labelled);
+  std::vector<uint8_t> held(static_cast<std::size_t>(n));
+  const float shell = float(r.auto_wall_thickness_mm);
+  int64_t count = 0;
+#pragma omp parallel for schedule(static) reduction(+ : count)
+  for (int64_t v = 0; v < n; ++v) {
+    held[v] = t.lungs[v] || (t.chest[v] && depth_mm[v] > shell);
+    if (held[v] && role[v] == kUndecided) role[v] = Role::Fixed;
+    count += held[v];
+  }
+  if (t.lung_ml > 0.0) {
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "roles: the chest above the diaphragm: lungs %.0f ml (%d part%s by density%s), %.0f ml held fixed, "
+                  "the diaphragm under it wall",
+                  t.lung_ml, t.lung_parts, t.lung_parts == 1 ? "" : "s", labelled.empty() ? "" : ", and the labelled lungs and heart",
+                  double(count) * g.spacing_mm.prod() / 1000.0);
+    log::info(line);
+  } else {
+    log::debug("roles: no lung in view: no chest above the diaphragm to hold");
+  }
+  return held;
+}
+
+/// Rule 5c: undecided voxels within auto_diaphragm_thickness_mm of the held chest → wall (the diaphragm).
+void wall_under_the_chest(std::vector<Role>& role, const std::vector<uint8_t>& held, const Geometry& g,
+                          const RoleRules& r) {
+  if (!(r.auto_diaphragm_thickness_mm > 0.0) || std::none_of(held.begin(), held.end(), [](uint8_t h) { return h; })) return;
+  const int64_t n = int64_t(role.size());
+  std::vector<uint8_t> away(static_cast<std::size_t>(n));
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v) away[v] = !held[v];
+  const std::vector<float> to_chest_mm = distance_to_outside_mm(away, g);
+  const float thickness = float(r.auto_diaphragm_thickness_mm);
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v)
+    if (role[v] == kUndecided && to_chest_mm[v] <= thickness) role[v] = Role::Wall;
+}
+
 /// Rule 4: undecided body voxels behind the spine's front → fixed.
 void fix_the_back(std::vector<Role>& role, const std::vector<uint8_t>& body, const std::vector<SliceCentre>& centres,
                   const SliceFrame& f) {
@@ -82,9 +147,8 @@ void fix_the_back(std::vector<Role>& role, const std::vector<uint8_t>& body, con
 }
 
 /// Rule 5: the shell, wall anterior and lateral, fixed behind.
-void assign_the_shell(std::vector<Role>& role, const std::vector<uint8_t>& body, const std::vector<SliceCentre>& centres,
-                      const SliceFrame& f, const Geometry& g, const RoleRules& r) {
-  const std::vector<float> depth_mm = distance_to_outside_mm(body, g);
+void assign_the_shell(std::vector<Role>& role, const std::vector<float>& depth_mm, const std::vector<SliceCentre>& centres,
+                      const SliceFrame& f, const RoleRules& r) {
   const float thickness = float(r.auto_wall_thickness_mm);
   const double cos_max = std::cos(r.auto_wall_max_angle_deg * M_PI / 180.0);
 #pragma omp parallel for schedule(static)
@@ -191,7 +255,7 @@ void fix_lateral_to_bone(std::vector<Role>& role, const std::vector<uint8_t>& bo
 
 std::vector<Role> auto_roles(const RoleRules& r, const Geometry& g, const float* hu, const uint16_t* label,
                              const std::vector<uint8_t>* given_body) {
-  Progress progress("roles", 6);
+  Progress progress("roles", 7);
   StageTimer timer(progress);
   const SliceFrame f = slice_frame(g);
 
@@ -202,24 +266,30 @@ std::vector<Role> auto_roles(const RoleRules& r, const Geometry& g, const float*
   timer.done(1, "body mask");
 
   std::vector<Role> role = decide_by_labels_and_hu(r, body, hu, label);
+  const std::vector<float> depth_mm = distance_to_outside_mm(body, g);
   timer.done(2, "labels and bone");
 
-  fix_the_back(role, body, centres, f);
-  timer.done(3, "back");
+  std::vector<uint8_t> chest;
+  if (r.auto_thorax) chest = fix_the_chest(role, r, g, hu, label, body, depth_mm);
+  timer.done(3, "chest");
 
-  assign_the_shell(role, body, centres, f, g, r);
+  fix_the_back(role, body, centres, f);
+  timer.done(4, "back");
+
+  assign_the_shell(role, depth_mm, centres, f, r);
   if (r.auto_use_labels) attach_prevesical_space(role, label, f, r);
-  timer.done(4, "wall shell");
+  if (r.auto_thorax) wall_under_the_chest(role, chest, g, r);
+  timer.done(5, "wall shell");
 
   fix_lateral_to_bone(role, body, hu, centres, f, r);
   if (r.auto_use_labels) attach_below_the_reflection(role, label, g, f, r);
-  timer.done(5, "lateral to bone");
+  timer.done(6, "lateral to bone");
 
   const int64_t n = int64_t(role.size());
 #pragma omp parallel for schedule(static)
   for (int64_t v = 0; v < n; ++v)
     if (role[v] == kUndecided) role[v] = Role::Viscera;   // rule 7
-  timer.done(6, "viscera");
+  timer.done(7, "viscera");
   progress.finish();
   return role;
 }

@@ -6,6 +6,9 @@
 //   2. outside the body → other. Body = HU > auto_body_threshold_hu, largest 6-connected part,
 //      holes filled per axial slice (body_mask.h);
 //   3. HU > auto_bone_threshold_hu → fixed (bone);
+//   3b. with auto_thorax: the chest above the diaphragm (anatomy/thorax.h: the lungs by density or
+//      by their labels, the diaphragm's surface under them, the heart and mediastinum between them):
+//      the lungs, and the rest of it deeper than auto_wall_thickness_mm, → fixed;
 //   4. the back: behind the anterior surface of the vertebral column in the slice → fixed
 //      (back_region.h; the column is found from rules 1 and 3's fixed voxels near the midline);
 //   5. the shell: within auto_wall_thickness_mm of the body's surface (3-D Euclidean distance in mm,
@@ -18,6 +21,8 @@
 //      of the bladder in the column (5b and 6b alike), the wall starts at that organ's front: the
 //      peritoneum lies in front of the bladder at that level, and the tissue behind the organ is on
 //      its peritoneal side;
+//   5c. with auto_thorax: undecided tissue within auto_diaphragm_thickness_mm of 3b's chest → wall:
+//      the diaphragm, so the gas opens under it, never beside a lung or the heart;
 //   6. deeper tissue lateral to bone that is at least 40 mm from the midline (hip joints, iliac
 //      wings, pubic rami: the gluteal, hip and thigh muscles) → fixed (lateral_to_bone.h);
 //   6b. with auto_use_labels and a label map: in the axial slices from the top (dome) of the
@@ -41,9 +46,10 @@
 //     colon) behind the front of the column become fixed.
 //   - The angle is measured around the slice's centroid, so a very asymmetric section shifts the
 //     wall's lateral limit.
-//   - No diaphragm: without labels, the thorax's contents (aerated lung, filled in as a hole, and the
-//     heart) become viscera. With the lungs and heart labelled fixed (TotalSegmentator has them) the
-//     back rule's run continues from the spine through the heart, and thoracic slices are held.
+//   - The diaphragm is a height field under the lungs (anatomy/thorax.h's limits); with no lung in
+//     view (a scan that starts below the lung bases) there is no chest to hold, and what lies at the
+//     top slice is decided by the other rules. The held chest continues the back rule's run from the
+//     spine through the heart, as labelled lungs and heart do.
 //   - Below the pelvic brim the rules are rough: without a bladder label (rule 6b), tissue in front
 //     of the pubic rami in rows without bone (the inguinal region, the front of the thighs) becomes
 //     viscera.

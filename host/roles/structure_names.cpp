@@ -100,6 +100,12 @@ Compartment compartment_of(const std::string& name) {
   return Compartment::Unknown;
 }
 
+bool lies_above_the_diaphragm(const std::string& name) {
+  static const std::regex chest("lungs?(_.*)?|heart(_.*)?|myocardium|atrial_appendage|pulmonary_(artery|vein|trunk)",
+                                std::regex::optimize);
+  return std::regex_match(normalised(name), chest);
+}
+
 RolesFromNames roles_from_names(const std::map<int, std::string>& names, const std::vector<int>& skip) {
   const std::set<int> skipped(skip.begin(), skip.end());
   RolesFromNames r;

@@ -33,6 +33,10 @@ const char* compartment_name(Compartment c);
 /// "kidney_cyst_right" are all retroperitoneal.
 Compartment compartment_of(const std::string& name);
 
+/// Whether the name is a structure of the chest above the diaphragm (a lung or its lobe, the heart or its
+/// chambers, the pulmonary vessels): what the thorax's diaphragm is found under (anatomy/thorax.h).
+bool lies_above_the_diaphragm(const std::string& name);
+
 /// What a label map's names give the roles: ids (sorted) per role, the attached and prevesical ids,
 /// and the names the table does not know.
 struct RolesFromNames {

@@ -120,6 +120,13 @@ const Table<RoleRules>& roles_table() {
       {"auto_wall_max_angle_deg", &RoleRules::auto_wall_max_angle_deg, "deg", in(0, 180),
        "auto: the shell is wall where the skin faces within this angle of anterior (90 = lateral); "
        "the rest of the shell (the back, on the table) is fixed, the body inside it viscera."},
+      {"auto_thorax", &RoleRules::auto_thorax, "", any(),
+       "auto: find the chest above the diaphragm (anatomy/thorax.h: the lungs by density or by their labels, the "
+       "diaphragm as the surface under them, the heart and mediastinum between them) and hold it fixed, so no gas "
+       "opens beside the lungs or the heart (docs/roles.md)."},
+      {"auto_diaphragm_thickness_mm", &RoleRules::auto_diaphragm_thickness_mm, "mm", in(0, 50),
+       "auto with auto_thorax: undecided tissue within this distance under the chest is wall (the diaphragm, a "
+       "muscle sheet of a few mm; 5 keeps a voxel of wall between lung and gas on 3 mm grids). 0: none."},
       {"auto_use_labels", &RoleRules::auto_use_labels, "", any(),
        "auto with a label map: voxels whose label is in a role list keep that role; HU rules fill in the rest."},
       {"by_name", &RoleRules::by_name, "", any(),
