@@ -120,7 +120,7 @@ const MeshCase& mesh_case(const Case& size) {
   {
     const Phantom ph = make_phantom(size.phantom);
     const RoleVolume rv = assign_roles(scene, ph.ct, &ph.labels);
-    c->mesh = build_scene_mesh(VoxelRoles{rv.geometry, rv.role.data(), rv.label.data(), rv.hu()}, scene);
+    c->mesh = build_scene_mesh(voxel_roles_of(rv), scene);
   }
   log::set_level(log_level);
   const SolveOptions opt = solve_options_from_scene(scene);

@@ -88,7 +88,7 @@ const WarpCase& warp_case() {
   const Scene scene = parse_scene(nlohmann::json::parse(phantom_scene_json(size)), "");
   const Phantom ph = make_phantom(size);
   c->roles = assign_roles(scene, ph.ct, &ph.labels);
-  const Mesh mesh = build_scene_mesh(VoxelRoles{c->roles.geometry, c->roles.role.data(), c->roles.label.data(), c->roles.hu()}, scene);
+  const Mesh mesh = build_scene_mesh(voxel_roles_of(c->roles), scene);
   const SolveResult r = solve_on_device(nullptr, mesh, solve_options_from_scene(scene));
   log::set_level(level);
   std::vector<Vec3> u(r.x.size());

@@ -1,5 +1,7 @@
-// The CT's cut faces (mesh.cut_faces, MeshOptions::cut_faces): where the grid's first or last axial
-// slice cuts tissue, "slide" holds those nodes on world z and nothing else.
+// The CT's cut faces (mesh.cut_faces, MeshOptions::cut_faces): where the CT's first or last slice
+// along the body's long axis, or its first or last column across it, cuts tissue, "slide" holds the
+// nodes of the lattice plane nearest that face on the face's normal (world z or x) and nothing else;
+// the front and back are never held.
 //
 // The physics check is a closed form: a thick-walled tube under internal pressure p, cut at both
 // ends of the grid. Held on z at both cut planes and free in them, a uniform prism's exact solution
@@ -138,6 +140,35 @@ TEST(CutFaces, AirAtTheGridsEndsIsNoCut) {
   const Mesh m = tube_mesh(tube(1, kSlices - 2), CutFaces::Slide);
   EXPECT_EQ(m.stats.cut_face_nodes, 0);
   for (uint8_t h : m.hold) EXPECT_EQ(h, 0);
+}
+
+TEST(CutFaces, TheCtsBoxInsideItsPaddingIsCutOnZAndXButNotY) {
+  // Wall fills the CT's box, voxels 2…17 on every axis of a 20³ grid of 1 mm (2 voxels of air padded
+  // around it), cubes of 2: its faces lie on lattice planes 1 and 9. Those planes are held on the
+  // face's normal, z and x; the front and back faces (y) are not.
+  Geometry g;
+  g.dims = {20, 20, 20};
+  std::vector<Role> roles(std::size_t(g.voxel_count()), Role::Other);
+  for (int64_t k = 2; k <= 17; ++k)
+    for (int64_t j = 2; j <= 17; ++j)
+      for (int64_t i = 2; i <= 17; ++i) roles[std::size_t(g.linear_index(i, j, k))] = Role::Wall;
+  VoxelRoles v{g, roles.data()};
+  v.ct_first = {2, 2, 2};
+  v.ct_last = {17, 17, 17};
+  MeshOptions mo;
+  mo.cube_voxels = 2;
+  mo.model = MeshModel::Wall;
+  const Mesh m = build_mesh(v, mo, [](Role, int) { return 1e3; });
+  auto face = [](int32_t c) { return c == 1 || c == 9; };
+  int64_t held = 0;
+  for (int64_t n = 0; n < m.node_count(); ++n) {
+    const auto& l = m.node_lattice[std::size_t(n)];
+    const uint8_t expected = uint8_t((face(l[0]) ? kHoldX : 0) | (face(l[2]) ? kHoldZ : 0));
+    EXPECT_EQ(m.hold[std::size_t(n)], expected) << "node at lattice (" << l[0] << "," << l[1] << "," << l[2] << ")";
+    held += expected != 0;
+  }
+  EXPECT_EQ(m.stats.cut_face_nodes, held);
+  EXPECT_GT(held, 0);
 }
 
 TEST(CutFaces, ATubeSlidingOnItsCutsIsInPlaneStrainAtTheCutAsInTheMiddle) {

@@ -19,9 +19,10 @@ TEST(RunFromCt, TheCtAndItsLabelsAloneGiveTheExamplesAnswer) {
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream m(out + "/metrics.json");
   const nlohmann::json metrics = nlohmann::json::parse(m);
-  // scenes/totalseg_example.json, which holds the same inputs and nothing else: 44.4 mm, 2442 ml
-  // (docs/fidelity.md). The same defaults give the same answer to the rounding of the warp.
-  EXPECT_NEAR(metrics["anterior_rise_mm"].get<double>(), 44.35, 0.05);
+  // scenes/totalseg_example.json, which holds the same inputs and nothing else: 44.3 mm, 2403 ml with
+  // the cut faces sliding and the chest held (bench/results/2026-12-07-any-ct-cases.md). The same
+  // defaults give the same answer to the rounding of the warp.
+  EXPECT_NEAR(metrics["anterior_rise_mm"].get<double>(), 44.28, 0.05);
   std::ifstream u(out + "/scene_used.json");
   const nlohmann::json used = nlohmann::json::parse(u);
   EXPECT_EQ(used["roles"]["viscera_labels"], nlohmann::json(std::vector<int>(kHandViscera)));

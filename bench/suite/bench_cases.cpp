@@ -39,7 +39,7 @@ void remesh(BenchCase& c, const CubeVoxels& cube_voxels) {
   c.scene.mesh.cube_voxels = cube_voxels;
   c.scene.mesh.cube_mm.reset();   // L in voxels here, whatever the scene said
   const auto t0 = Clock::now();
-  c.mesh = build_scene_mesh(VoxelRoles{c.roles.geometry, c.roles.role.data(), c.roles.label.data(), c.roles.hu()}, c.scene);
+  c.mesh = build_scene_mesh(voxel_roles_of(c.roles), c.scene);
   c.seconds_mesh = seconds_since(t0);
 }
 

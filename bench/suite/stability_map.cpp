@@ -70,8 +70,7 @@ json measure_stability_map(BenchContext& ctx) {
       scene.material.wall_young_kpa.reset();
       scene.material.viscera_young_kpa.reset();
       scene.material.label_young_kpa.clear();
-      const Mesh mesh = build_scene_mesh(VoxelRoles{c.roles.geometry, c.roles.role.data(), c.roles.label.data(), c.roles.hu()},
-                                         scene);
+      const Mesh mesh = build_scene_mesh(voxel_roles_of(c.roles), scene);
       for (const SolverMethod method : {SolverMethod::Explicit, SolverMethod::Newmark}) {
         scene.solver.method = method;
         const SolveOptions opt = solve_options_from_scene(scene);

@@ -40,6 +40,10 @@ struct VoxelRoles {
   const Role* role = nullptr;       // voxel_count() entries
   const uint16_t* label = nullptr;  // optional: organ labels for per-label Young's modulus
   const float* hu = nullptr;        // optional: the CT (HU), for moduli by tissue density (fat)
+  /// The CT's own voxels within the grid, first and last index per axis (the rest is air padded
+  /// around it); a last of -1 is the grid's last. Its faces are where the CT may cut the body
+  /// (MeshOptions::cut_faces).
+  Index3 ct_first{0, 0, 0}, ct_last{-1, -1, -1};
 };
 
 /// Young's modulus (Pa) of one voxel of tissue: its role, label (0 when none) and HU (0 without a CT).
@@ -63,11 +67,12 @@ struct MeshOptions {
   /// extraperitoneal organs the viscera lie on): no gas pressure on those voxel faces, and their
   /// nodes marked in Mesh::node_attached for the bond of solve/interface_tie.h.
   std::vector<int> attached_labels;
-  /// The faces where the grid cuts the body across its long axis (a scan that stops at the liver or at
-  /// L3): Slide holds their nodes on the cut plane's normal (world z) and leaves them free within it,
-  /// as a symmetry plane does: the body beyond is taken as the mirror image of the body inside, so
-  /// the wall's cut edge neither lifts like a flap nor lets the viscera out (docs/fidelity.md, "Cut
-  /// faces"). Free leaves them free, as a real edge of tissue would be.
+  /// The faces where the CT cuts the body (a scan that stops at the liver or at L3, a field of view
+  /// that cuts the flanks): Slide holds the nodes of the lattice plane nearest each cranial, caudal
+  /// and lateral face of the CT's box (VoxelRoles::ct_first/ct_last) that cuts tissue on the face's
+  /// normal (world z or x) and leaves them free within it, as a symmetry plane does: the body beyond is taken as the mirror image of the body
+  /// inside, so the wall's cut edge neither lifts like a flap nor lets gas or viscera out
+  /// (docs/fidelity.md, "Cut faces"). Free leaves them free, as a real edge of tissue would be.
   CutFaces cut_faces = CutFaces::Slide;
 };
 
@@ -109,7 +114,7 @@ struct ContactFaces {
 
 struct MeshStats {
   int64_t nodes = 0, tetrahedra = 0, springs = 0, fixed_nodes = 0;
-  int64_t cut_face_nodes = 0;      // nodes held on a cut face's normal only (MeshOptions::cut_faces)
+  int64_t cut_face_nodes = 0;      // nodes held on cut faces' normals only (MeshOptions::cut_faces)
   int64_t cavity_faces = 0;        // voxel faces between wall and viscera, both sides counted
   int64_t attached_faces = 0;      // of those, the ones of an attached label (no gas), both sides
   int64_t pressure_tetrahedra = 0; // tetrahedra carrying some of them

@@ -177,18 +177,18 @@ bool touches_fixed(const VoxelRoles& roles, int64_t a, int64_t b, int64_t c, con
   return false;
 }
 
-/// The grid axis that crosses the body's long axis (the one nearest world z), or -1 where it leans
-/// from world z by more than 1° (a tilted gantry): a node's holds are world axes, so a cut plane
-/// oblique to them cannot be held on its normal alone, and its faces stay free.
-int cut_axis(const Geometry& g) {
-  int k = 0;
-  for (int a = 1; a < 3; ++a)
-    if (std::abs(g.direction(2, a)) > std::abs(g.direction(2, k))) k = a;
-  return std::abs(g.direction(2, k)) >= std::cos(1.0 * 3.14159265358979323846 / 180.0) ? k : -1;
+/// The hold bit of the world axis grid axis `a` runs along, or 0 where it leans from every world axis
+/// by more than 1° (a tilted gantry): a node's holds are world axes, so a face oblique to them cannot
+/// be held on its normal alone, and stays free.
+uint8_t world_hold_of(const Geometry& g, int a) {
+  int w = 0;
+  for (int r = 1; r < 3; ++r)
+    if (std::abs(g.direction(r, a)) > std::abs(g.direction(w, a))) w = r;
+  return std::abs(g.direction(w, a)) >= std::cos(1.0 * 3.14159265358979323846 / 180.0) ? uint8_t(1 << w) : 0;
 }
 
-/// Whether the grid's end slice `slice` along `axis` holds tissue (any role but other) in the cubes
-/// around the lattice node `n` on that end: the grid cuts the body there.
+/// Whether the CT's boundary slice `slice` along `axis` holds tissue (any role but other) in the cubes
+/// around the lattice node `n`: the CT cuts the body there.
 bool cut_through_tissue(const VoxelRoles& roles, const std::array<int64_t, 3>& n, int axis, int64_t slice,
                         const CubeVoxels& L) {
   const Geometry& g = roles.geometry;
@@ -710,21 +710,34 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
           if (node_id[p][ni] >= 0) m.hold[node_id[p][ni]] = kHoldAll;
       }
 
-  // Cut faces: the lattice's end planes along the body's long axis where the grid's end slice cuts
-  // tissue; held on world z, free in the plane (MeshOptions::cut_faces).
-  const int axis = opt.cut_faces == CutFaces::Slide ? cut_axis(g) : -1;
-  if (axis >= 0)
-    for (int64_t c = 0; c <= lat.cubes[2]; ++c)
-      for (int64_t b = 0; b <= lat.cubes[1]; ++b)
-        for (int64_t a = 0; a <= lat.cubes[0]; ++a) {
-          const std::array<int64_t, 3> n{a, b, c};
-          if (n[axis] != 0 && n[axis] != lat.cubes[axis]) continue;
-          const int64_t ni = lat.node_index(a, b, c);
-          if (node_id[0][ni] < 0 && node_id[1][ni] < 0) continue;
-          if (!cut_through_tissue(roles, n, axis, n[axis] == 0 ? 0 : g.dims[axis] - 1, L)) continue;
-          for (int p = 0; p < kParts; ++p)
-            if (node_id[p][ni] >= 0) m.hold[node_id[p][ni]] |= kHoldZ;
-        }
+  // Cut faces: on each face of the CT's box that cuts tissue, the lattice plane nearest to it, held on
+  // the face's normal and free in it (MeshOptions::cut_faces).
+  if (opt.cut_faces == CutFaces::Slide)
+    for (int axis = 0; axis < 3; ++axis) {
+      // Not the front and back: a field of view that cuts the anterior skin leaves the wall free to
+      // rise there (a mirror would hold it), and the back lies on the table, fixed.
+      const uint8_t bit = world_hold_of(g, axis);
+      if (!bit || bit == kHoldY) continue;
+      const int64_t first = std::clamp<int64_t>(roles.ct_first[axis], 0, g.dims[axis] - 1);
+      const int64_t last = roles.ct_last[axis] < 0 ? g.dims[axis] - 1 : std::clamp<int64_t>(roles.ct_last[axis], first, g.dims[axis] - 1);
+      // A face between voxels b − 1 and b lies on lattice plane b / L.
+      const struct { int64_t slice, plane; } faces[2] = {
+          {first, std::clamp<int64_t>((2 * first + L[axis]) / (2 * L[axis]), 0, lat.cubes[axis])},
+          {last, std::clamp<int64_t>((2 * (last + 1) + L[axis]) / (2 * L[axis]), 0, lat.cubes[axis])}};
+      for (const auto& face : faces) {
+        std::array<int64_t, 3> n{};
+        n[axis] = face.plane;
+        const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+        for (n[w] = 0; n[w] <= lat.cubes[w]; ++n[w])
+          for (n[u] = 0; n[u] <= lat.cubes[u]; ++n[u]) {
+            const int64_t ni = lat.node_index(n[0], n[1], n[2]);
+            if (node_id[0][ni] < 0 && node_id[1][ni] < 0) continue;
+            if (!cut_through_tissue(roles, n, axis, face.slice, L)) continue;
+            for (int p = 0; p < kParts; ++p)
+              if (node_id[p][ni] >= 0 && m.hold[node_id[p][ni]] != kHoldAll) m.hold[node_id[p][ni]] |= bit;
+          }
+      }
+    }
 
   const AttachedLabels attached(opt.attached_labels);
   build_pressure_loads(m, roles, lat, L, meshed, first_tet, attached);
@@ -758,7 +771,7 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
   m.stats.springs = int64_t(m.springs.size());
   for (int64_t i = 0; i < N; ++i) {
     m.stats.fixed_nodes += m.hold[i] == kHoldAll;
-    m.stats.cut_face_nodes += m.hold[i] == kHoldZ;
+    m.stats.cut_face_nodes += m.hold[i] != 0 && m.hold[i] != kHoldAll;
     ++(m.node_part[i] == Part::Wall ? m.stats.wall_nodes : m.stats.viscera_nodes);
   }
   return m;

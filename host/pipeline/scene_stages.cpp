@@ -38,6 +38,15 @@ RoleVolume load_roles(const Scene& scene, InputVolumes* inputs) {
   return roles;
 }
 
+VoxelRoles voxel_roles_of(const RoleVolume& roles) {
+  VoxelRoles v{roles.geometry, roles.role.data(), roles.label.data(), roles.hu()};
+  for (int a = 0; a < 3; ++a) {
+    v.ct_first[a] = roles.pad.lo[a];
+    v.ct_last[a] = roles.geometry.dims[a] - 1 - roles.pad.hi[a];
+  }
+  return v;
+}
+
 Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene, bool to_solve) {
   MeshOptions opt;
   opt.cube_voxels = cube_voxels_for(scene.mesh, roles.geometry);

@@ -22,6 +22,10 @@ struct InputVolumes {
 };
 RoleVolume load_roles(const Scene& scene, InputVolumes* inputs = nullptr);
 
+/// What the mesh is built from on a case's working grid: its roles, labels and HU, and where the CT
+/// lies within the padding (its faces are the cut faces, MeshOptions::cut_faces).
+VoxelRoles voxel_roles_of(const RoleVolume& roles);
+
 /// The mesh of a case: mesh.* (the cube size from the CT's spacing when mesh.cube_mm is set),
 /// material.* per role, label and HU (Scene::young_kpa_for, poisson_for), masses and springs. With
 /// `to_solve` the memory estimate checked before building counts the solver's state too.

@@ -54,7 +54,7 @@ Simulation prepare_simulation(const Scene& scene, bool keep_inputs) {
   for (const std::string& w : sim.coverage.warnings) log::warn("scan: " + w);
 
   t0 = std::chrono::steady_clock::now();
-  sim.mesh = build_scene_mesh(VoxelRoles{sim.roles.geometry, sim.roles.role.data(), sim.roles.label.data(), sim.roles.hu()}, scene, /*to_solve=*/true);
+  sim.mesh = build_scene_mesh(voxel_roles_of(sim.roles), scene, /*to_solve=*/true);
   sim.stage_seconds_mesh = seconds_since(t0);
   const MeshStats& s = sim.mesh.stats;
   std::ostringstream os;

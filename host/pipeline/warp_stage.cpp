@@ -114,7 +114,7 @@ void grow_to_hold_the_deformed_body(WarpedCase& w) {
 DeformedMesh load_deformed_mesh(const Scene& scene, const std::string& sim_dir) {
   DeformedMesh d;
   d.roles = load_roles(scene);
-  d.mesh = build_scene_mesh(VoxelRoles{d.roles.geometry, d.roles.role.data(), d.roles.label.data(), d.roles.hu()}, scene);
+  d.mesh = build_scene_mesh(voxel_roles_of(d.roles), scene);
   d.deformation = read_deformation(in_dir(sim_dir, "deformation.bin"), d.mesh);
   d.warp_mesh = make_warp_mesh(d.mesh, d.deformation.displacement_m);
   return d;
@@ -139,7 +139,7 @@ WarpedCase warp_scene(const Scene& scene, const std::string& sim_dir) {
   std::optional<Volume> labels;
   if (!scene.inputs.labels.empty()) labels = read_volume(scene.inputs.labels);
   RoleVolume roles = assign_roles(scene, ct, labels ? &*labels : nullptr);
-  Mesh mesh = build_scene_mesh(VoxelRoles{roles.geometry, roles.role.data(), roles.label.data(), roles.hu()}, scene);
+  Mesh mesh = build_scene_mesh(voxel_roles_of(roles), scene);
   Deformation deformation = read_deformation(in_dir(sim_dir, "deformation.bin"), mesh);
   const double scene_pa = units::mmhg_to_pa(scene.load.pressure_mmhg);
   if (scene.load.pressure_curve_mmhg.empty() && std::abs(deformation.pressure_pa - scene_pa) > 1e-6 * scene_pa)

@@ -110,7 +110,8 @@ ScanCoverage scan_coverage(const RoleVolume& rv, const std::map<int, std::string
                          "abdominal wall is cut at the bottom slice (by default held there as if it continued, "
                          "mesh.cut_faces), and the cavity below it is missing");
   if (c.wall_cut_laterally)
-    c.warnings.push_back("the field of view cuts the abdominal wall at the side: the flank beyond it is missing");
+    c.warnings.push_back("the field of view cuts the abdominal wall at the side: the flank beyond it is missing "
+                         "(by default held at the cut as if it continued, mesh.cut_faces)");
   if (c.wall_cut_anteriorly)
     c.warnings.push_back("the field of view cuts the abdominal wall in front: its skin is missing there");
   return c;

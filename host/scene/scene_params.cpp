@@ -177,10 +177,11 @@ const Table<SceneMesh>& mesh_table() {
        "\"newton\" or \"implicit-euler\". TotalSegmentator: the example scene's wall_labels. Empty: every "
        "wall-viscera interface may open."},
       {"cut_faces", &SceneMesh::cut_faces, "", any(),
-       "Where the CT stops across the body (cut at L3, at the liver): \"slide\" holds the cut face's nodes "
-       "cranio-caudally and leaves them free in its plane, as if the body continued beyond as its mirror image "
-       "(docs/fidelity.md, cut faces); \"free\": the cut face is a free surface, and the wall's edge lifts like "
-       "a flap. Faces of padded air are not cut faces."},
+       "Where the CT cuts the body (at L3, at the liver, a field of view that cuts the flanks): \"slide\" holds "
+       "the cut face's nodes on its normal (cranio-caudally, or laterally) and leaves them free in its plane, as if "
+       "the body continued beyond as its mirror image (docs/fidelity.md, cut faces); the front and back are never "
+       "held. \"free\": the cut face is a free surface, and the wall's edge lifts like a flap. The faces are the "
+       "CT's own, inside the air the roles pad around it."},
   };
   return t;
 }

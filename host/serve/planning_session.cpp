@@ -130,9 +130,7 @@ void PlanningSession::inflate(const InflateRequest& request, SerialWorker& worke
     x_ = sim_.mesh.rest_m;
     pressure_pa_ = 0.0;
   } else if (next.echo()["material"] != scene_.echo()["material"]) {
-    sim_.mesh = build_scene_mesh(VoxelRoles{sim_.roles.geometry, sim_.roles.role.data(), sim_.roles.label.data(),
-                                            sim_.roles.hu()},
-                                 next, /*to_solve=*/true);
+    sim_.mesh = build_scene_mesh(voxel_roles_of(sim_.roles), next, /*to_solve=*/true);
   }
   scene_ = next;
   worker.checkpoint(generation);
