@@ -1,0 +1,249 @@
+// Issue "Any patient's CT": the example CT cut and changed as other patients' scans are, each run as
+// a new user would (`pneumo run` on a scene holding only its inputs and 12 mmHg, every default), and
+// what must hold on every case checked on the deformed CT and labels:
+//   - the run converges (exit 0) and the anterior rise is an adult's, 25–60 mm (method.md §10);
+//   - no gas voxel touches a lung or the heart (6-adjacent, in the deformed labels);
+//   - no gas voxel touches the air outside the body, within the CT's cranio-caudal and lateral
+//     extent and more than a cube (9 mm) from its ends: beyond a cut lies no data, the output grid
+//     shows air there, and the plane held lies up to half a cube from the CT's last slice
+//     (docs/fidelity.md, "Cut faces");
+//   - a cropped case moves the skin as the whole CT does: over the (x, z) columns both hold where
+//     the whole CT's skin rises more than 5 mm, the median of |crop − whole| / whole ≤ 20 %.
+// The cases: the whole CT with its labels and without them (the HU rules alone), cut at L3 (no
+// pelvis), through the liver's middle, with a tight lateral field of view, and with arterial-phase
+// contrast in the aorta and iliac arteries (400 HU). Figures at writing: bench/results/
+// 2026-12-07-any-ct-cases.md.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <vector>
+
+#include "cli_test_support.h"
+#include "example_roles_support.h"
+#include "io/volume_io.h"
+#include "io_test_support.h"
+
+using namespace pneumo;
+using namespace pneumo::testing_support;
+
+namespace {
+
+constexpr int kCavityLabel = 250;
+
+/// The voxels lo..hi (inclusive, per axis) of `v` on the grid they occupy.
+Volume crop(const Volume& v, const Index3& lo, const Index3& hi) {
+  Geometry g = v.geometry();
+  for (int a = 0; a < 3; ++a) g.dims[a] = hi[a] - lo[a] + 1;
+  g.origin_mm = v.geometry().to_world(Vec3(double(lo[0]), double(lo[1]), double(lo[2])));
+  Volume out(g, v.type());
+  const std::size_t size = voxel_size(v.type());
+  const auto* src = static_cast<const uint8_t*>(v.raw());
+  auto* dst = static_cast<uint8_t*>(out.raw());
+  for (int64_t k = 0; k < g.dims[2]; ++k)
+    for (int64_t j = 0; j < g.dims[1]; ++j)
+      std::copy_n(src + std::size_t(v.geometry().linear_index(lo[0], lo[1] + j, lo[2] + k)) * size, std::size_t(g.dims[0]) * size,
+                  dst + std::size_t(g.linear_index(0, j, k)) * size);
+  return out;
+}
+
+/// The k range label `id` occupies.
+std::pair<int64_t, int64_t> slices_of(const Volume& labels, int id) {
+  const Geometry& g = labels.geometry();
+  int64_t lo = g.dims[2], hi = -1;
+  for (int64_t n = 0; n < labels.voxel_count(); ++n)
+    if (int(labels.value(n)) == id) {
+      lo = std::min(lo, n / (g.dims[0] * g.dims[1]));
+      hi = std::max(hi, n / (g.dims[0] * g.dims[1]));
+    }
+  return {lo, hi};
+}
+
+std::map<int, std::string> example_names() {
+  std::map<int, std::string> names;
+  std::ifstream in(totalseg_dir() + "/labels.csv");
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto comma = line.find(',');
+    if (comma == std::string::npos || !std::isdigit(static_cast<unsigned char>(line[0]))) continue;
+    const auto second = line.find(',', comma + 1);
+    names[std::stoi(line.substr(0, comma))] = line.substr(comma + 1, second - comma - 1);
+  }
+  return names;
+}
+
+struct Outcome {
+  int code = -1;
+  std::string err;
+  double rise_mm = 0.0;
+  int64_t gas_touching_lung_or_heart = 0, gas_touching_outside_air = 0;
+  std::map<std::pair<long, long>, double> skin_mm;   // (x, z) in 0.1 mm → anterior skin height, deformed − rest
+};
+
+/// The most anterior voxel above −500 HU per (x, z) column, in world mm (RAS grids: y is j).
+std::map<std::pair<long, long>, double> skin_heights(const Volume& ct) {
+  const Geometry& g = ct.geometry();
+  std::map<std::pair<long, long>, double> out;
+  for (int64_t k = 0; k < g.dims[2]; ++k)
+    for (int64_t i = 0; i < g.dims[0]; ++i)
+      for (int64_t j = g.dims[1] - 1; j >= 0; --j)
+        if (ct.value(i, j, k) > -500.0) {
+          const Vec3 p = g.to_world(Vec3(double(i), double(j), double(k)));
+          out[{std::lround(p[0] * 10), std::lround(p[2] * 10)}] = p[1];
+          break;
+        }
+  return out;
+}
+
+/// Runs `pneumo run` on CT (and labels, when given) and measures the outcome.
+Outcome run_case(const ScratchDir& dir, const std::string& name, const Volume& ct, const Volume* labels,
+                 bool by_name = true) {
+  const std::string ct_path = dir.file(name + "_ct.nii.gz"), seg_path = dir.file(name + "_seg.nii.gz");
+  write_volume(ct, ct_path);
+  nlohmann::json scene = {{"name", name}, {"load", {{"pressure_mmhg", 12}}}};
+  scene["inputs"] = {{"ct", ct_path}};
+  if (labels) {
+    write_volume(*labels, seg_path);
+    scene["inputs"]["labels"] = seg_path;
+    scene["inputs"]["label_names"] = totalseg_dir() + "/labels.csv";
+  }
+  if (!by_name) scene["roles"] = {{"by_name", false}, {"auto_use_labels", false}};
+  const std::string scene_path = dir.file(name + ".json"), out = dir.file(name);
+  std::ofstream(scene_path) << scene.dump(2);
+  const CliResult r = run_pneumo("-q run " + scene_path + " --out " + out);
+  Outcome o;
+  o.code = r.code;
+  o.err = r.err;
+  if (r.code != 0) return o;
+  o.rise_mm = nlohmann::json::parse(slurp(out + "/metrics.json"))["anterior_rise_mm"].get<double>();
+
+  const Volume hu = read_volume(out + "/deformed_ct.nii.gz"), lab = read_volume(out + "/deformed_labels.nii.gz");
+  const Geometry& g = hu.geometry();
+  std::set<int> chest_ids;
+  for (const auto& [id, n] : example_names())
+    if (n.rfind("lung", 0) == 0 || n == "heart") chest_ids.insert(id);
+  // The CT's extent less a cube at each cranial, caudal and lateral end, as world x and z (RAS grids).
+  const Vec3 c0 = ct.geometry().to_world(Vec3(0, 0, 0));
+  const Vec3 c1 = ct.geometry().to_world(Vec3(double(ct.geometry().dims[0] - 1), 0, double(ct.geometry().dims[2] - 1)));
+  const Vec3 lo = c0.cwiseMin(c1) + Vec3::Constant(9.0), hi = c0.cwiseMax(c1) - Vec3::Constant(9.0);
+  // Outside air: below −500 HU, not gas, no label, connected to the grid's faces (flood fill).
+  const int64_t n = g.voxel_count();
+  std::vector<uint8_t> outside(std::size_t(n), 0);
+  std::vector<int64_t> queue;
+  auto air = [&](int64_t v) { return hu.value(v) < -500.0 && int(lab.value(v)) == 0; };
+  for (int64_t k = 0; k < g.dims[2]; ++k)
+    for (int64_t j = 0; j < g.dims[1]; ++j)
+      for (int64_t i = 0; i < g.dims[0]; ++i) {
+        const bool face = i == 0 || j == 0 || k == 0 || i == g.dims[0] - 1 || j == g.dims[1] - 1 || k == g.dims[2] - 1;
+        const int64_t v = g.linear_index(i, j, k);
+        if (face && air(v)) { outside[v] = 1; queue.push_back(v); }
+      }
+  for (std::size_t q = 0; q < queue.size(); ++q) {
+    const int64_t v = queue[q], i = v % g.dims[0], j = (v / g.dims[0]) % g.dims[1], k = v / (g.dims[0] * g.dims[1]);
+    const int64_t nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k}, {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+    for (const auto& c : nb) {
+      if (c[0] < 0 || c[1] < 0 || c[2] < 0 || c[0] >= g.dims[0] || c[1] >= g.dims[1] || c[2] >= g.dims[2]) continue;
+      const int64_t w = g.linear_index(c[0], c[1], c[2]);
+      if (!outside[w] && air(w)) { outside[w] = 1; queue.push_back(w); }
+    }
+  }
+  std::vector<uint8_t> counted_lung(std::size_t(n), 0), counted_air(std::size_t(n), 0);
+  for (int64_t k = 0; k < g.dims[2]; ++k)
+    for (int64_t j = 0; j < g.dims[1]; ++j)
+      for (int64_t i = 0; i < g.dims[0]; ++i) {
+        if (int(lab.value(i, j, k)) != kCavityLabel) continue;
+        const int64_t nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k}, {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+        for (const auto& c : nb) {
+          if (c[0] < 0 || c[1] < 0 || c[2] < 0 || c[0] >= g.dims[0] || c[1] >= g.dims[1] || c[2] >= g.dims[2]) continue;
+          const int64_t w = g.linear_index(c[0], c[1], c[2]);
+          if (chest_ids.count(int(lab.value(w))) && !counted_lung[w]) { counted_lung[w] = 1; ++o.gas_touching_lung_or_heart; }
+          const Vec3 p = g.to_world(Vec3(double(c[0]), double(c[1]), double(c[2])));
+          const bool within = p[0] >= lo[0] && p[0] <= hi[0] && p[2] >= lo[2] && p[2] <= hi[2];
+          if (outside[w] && within && !counted_air[w]) { counted_air[w] = 1; ++o.gas_touching_outside_air; }
+        }
+      }
+  const auto before = skin_heights(ct), after = skin_heights(hu);
+  for (const auto& [key, y] : before)
+    if (const auto it = after.find(key); it != after.end()) o.skin_mm[key] = it->second - y;
+  return o;
+}
+
+void expect_a_human_answer(const Outcome& o) {
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_GE(o.rise_mm, 25.0);
+  EXPECT_LE(o.rise_mm, 60.0);
+  EXPECT_EQ(o.gas_touching_lung_or_heart, 0);
+  EXPECT_EQ(o.gas_touching_outside_air, 0);
+}
+
+/// Median over the columns both hold where the whole CT's skin rises more than 5 mm of |crop − whole| / whole.
+double median_skin_difference(const Outcome& whole, const Outcome& cropped) {
+  std::vector<double> d;
+  for (const auto& [key, rise] : whole.skin_mm)
+    if (rise > 5.0)
+      if (const auto it = cropped.skin_mm.find(key); it != cropped.skin_mm.end()) d.push_back(std::abs(it->second - rise) / rise);
+  if (d.empty()) return INFINITY;
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
+struct Example {
+  Volume ct = read_volume(example_ct_path()), labels = read_volume(example_labels_path());
+};
+
+void check_crop(const char* name, const Index3& lo, const Index3& hi) {
+  PNEUMO_REQUIRE_REAL_CT();
+  const Example e;
+  ScratchDir dir;
+  const Outcome whole = run_case(dir, "whole", e.ct, &e.labels);
+  const Volume ct = crop(e.ct, lo, hi), labels = crop(e.labels, lo, hi);
+  const Outcome cut = run_case(dir, name, ct, &labels);
+  expect_a_human_answer(cut);
+  EXPECT_LE(median_skin_difference(whole, cut), 0.20);
+}
+
+}  // namespace
+
+TEST(AnyCtCases, TheWholeExampleWithAndWithoutItsLabels) {
+  PNEUMO_REQUIRE_REAL_CT();
+  const Example e;
+  ScratchDir dir;
+  expect_a_human_answer(run_case(dir, "labels", e.ct, &e.labels));
+  // The labels travel only to be counted against: the roles come from the HU rules alone.
+  expect_a_human_answer(run_case(dir, "hu_rules", e.ct, &e.labels, /*by_name=*/false));
+}
+
+TEST(AnyCtCases, CutAtL3AboveThePelvis) {
+  const Volume labels = read_volume(example_labels_path());
+  const auto [lo, hi] = slices_of(labels, 29);   // vertebrae_L3; RAS: k grows towards the head
+  const Index3 d = labels.geometry().dims;
+  check_crop("l3", {0, 0, (lo + hi) / 2}, {d[0] - 1, d[1] - 1, d[2] - 1});
+}
+
+TEST(AnyCtCases, CutThroughTheLiversMiddle) {
+  const Volume labels = read_volume(example_labels_path());
+  const auto [lo, hi] = slices_of(labels, 5);   // liver
+  const Index3 d = labels.geometry().dims;
+  check_crop("liver", {0, 0, 0}, {d[0] - 1, d[1] - 1, (lo + hi) / 2});
+}
+
+TEST(AnyCtCases, ATightLateralFieldOfView) {
+  const Index3 d = read_volume(example_labels_path()).geometry().dims;
+  check_crop("lateral", {15, 0, 0}, {d[0] - 16, d[1] - 1, d[2] - 1});   // 45 mm off each side
+}
+
+TEST(AnyCtCases, ArterialContrastInTheAortaAndIliacArteries) {
+  PNEUMO_REQUIRE_REAL_CT();
+  const Example e;
+  Volume ct(e.ct.geometry(), VoxelType::Float32);
+  const std::vector<float> hu = e.ct.to_float32();
+  float* out = ct.data<float>();
+  const std::set<int> arteries{52, 65, 66};   // aorta, iliac arteries (TotalSegmentator v2)
+  for (int64_t v = 0; v < ct.voxel_count(); ++v) out[v] = arteries.count(int(e.labels.value(v))) ? 400.0f : hu[v];
+  ScratchDir dir;
+  expect_a_human_answer(run_case(dir, "arterial", ct, &e.labels));
+}
