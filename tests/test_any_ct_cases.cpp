@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "cli_test_support.h"
+#include "crop_test_support.h"
 #include "example_roles_support.h"
 #include "io/volume_io.h"
 #include "io_test_support.h"
@@ -34,34 +35,6 @@ using namespace pneumo::testing_support;
 namespace {
 
 constexpr int kCavityLabel = 250;
-
-/// The voxels lo..hi (inclusive, per axis) of `v` on the grid they occupy.
-Volume crop(const Volume& v, const Index3& lo, const Index3& hi) {
-  Geometry g = v.geometry();
-  for (int a = 0; a < 3; ++a) g.dims[a] = hi[a] - lo[a] + 1;
-  g.origin_mm = v.geometry().to_world(Vec3(double(lo[0]), double(lo[1]), double(lo[2])));
-  Volume out(g, v.type());
-  const std::size_t size = voxel_size(v.type());
-  const auto* src = static_cast<const uint8_t*>(v.raw());
-  auto* dst = static_cast<uint8_t*>(out.raw());
-  for (int64_t k = 0; k < g.dims[2]; ++k)
-    for (int64_t j = 0; j < g.dims[1]; ++j)
-      std::copy_n(src + std::size_t(v.geometry().linear_index(lo[0], lo[1] + j, lo[2] + k)) * size, std::size_t(g.dims[0]) * size,
-                  dst + std::size_t(g.linear_index(0, j, k)) * size);
-  return out;
-}
-
-/// The k range label `id` occupies.
-std::pair<int64_t, int64_t> slices_of(const Volume& labels, int id) {
-  const Geometry& g = labels.geometry();
-  int64_t lo = g.dims[2], hi = -1;
-  for (int64_t n = 0; n < labels.voxel_count(); ++n)
-    if (int(labels.value(n)) == id) {
-      lo = std::min(lo, n / (g.dims[0] * g.dims[1]));
-      hi = std::max(hi, n / (g.dims[0] * g.dims[1]));
-    }
-  return {lo, hi};
-}
 
 std::map<int, std::string> example_names() {
   std::map<int, std::string> names;

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "core/progress.h"
+#include "crop_test_support.h"
 #include "example_roles_support.h"
 #include "io/volume_io.h"
 #include "pipeline/scene_stages.h"
@@ -15,33 +16,6 @@ using namespace pneumo;
 using namespace pneumo::testing_support;
 
 namespace {
-
-/// Slices k0..k1 (inclusive) of `v`, on the grid those slices occupy.
-Volume crop_slices(const Volume& v, int64_t k0, int64_t k1) {
-  Geometry g = v.geometry();
-  g.dims[2] = k1 - k0 + 1;
-  g.origin_mm = v.geometry().to_world(Vec3(0, 0, double(k0)));
-  Volume out(g, v.type());
-  const int64_t slice = g.dims[0] * g.dims[1];
-  const std::size_t bytes = std::size_t(slice) * voxel_size(v.type());
-  for (int64_t k = 0; k < g.dims[2]; ++k)
-    std::copy_n(static_cast<const uint8_t*>(v.raw()) + std::size_t(k0 + k) * bytes, bytes,
-                static_cast<uint8_t*>(out.raw()) + std::size_t(k) * bytes);
-  return out;
-}
-
-/// The k range a label occupies.
-std::pair<int64_t, int64_t> slices_of(const Volume& labels, int id) {
-  const Geometry& g = labels.geometry();
-  int64_t lo = g.dims[2], hi = -1;
-  for (int64_t n = 0; n < labels.voxel_count(); ++n)
-    if (int(labels.value(n)) == id) {
-      const int64_t k = n / (g.dims[0] * g.dims[1]);
-      lo = std::min(lo, k);
-      hi = std::max(hi, k);
-    }
-  return {lo, hi};
-}
 
 struct Case {
   Volume ct, labels;
