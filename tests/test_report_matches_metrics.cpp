@@ -430,7 +430,8 @@ TEST(ReportMatchesMetrics, EveryFigureOfEveryKnownKeyIsItsMetric) {
   // is the stored value to the 4 digits printed (÷ 100 in %), in the unit the key's suffix promises.
   json m = json::object();
   int i = 0;
-  // Entries of an array's columns (pressure_curve.*) land in an object here; the array set below replaces it.
+  // Entries of an array's columns (pressure_curve.*, organ_motion.*) land in an object here; the arrays
+  // set below replace them.
   for (const std::string& key : listed_metric_keys()) m[pointer_of(key)] = distinctive_value(key, i++);
   m["some_new_length_mm"] = 2.718;
   m["some_new_share_fraction"] = 0.0123;
@@ -446,6 +447,15 @@ TEST(ReportMatchesMetrics, EveryFigureOfEveryKnownKeyIsItsMetric) {
                                    {"steps", 17 + p},
                                    {"residual", 0.000987 * (p + 1)},
                                    {"wall_time_s", 0.4321 * (p + 1)}});
+  m["organ_motion"] = json::array();
+  for (int o = 0; o < 2; ++o)
+    m["organ_motion"].push_back({{"label", 5 + o},
+                                 {"name", o ? "spleen" : "liver"},
+                                 {"volume_ml", 1234.5 + 98.7 * o},
+                                 {"volume_change_fraction", -0.0417 + 0.0123 * o},
+                                 {"shift_right_mm", 1.234 - o},
+                                 {"shift_anterior_mm", -4.321 + o},
+                                 {"shift_superior_mm", 2.468 + o}});
   m["stage_seconds"] = {{"roles", 0.1234}, {"mesh", 1.357}, {"solve", 24.68}, {"warp", 3.579},
                         {"render", 8.642}, {"report", 0.0975}, {"total", 38.52}};
   m["landmarks"] = {{"measured", true},

@@ -17,6 +17,7 @@
 #include "io/volume_io.h"
 #include "image/png.h"
 #include "pipeline/cavity_measures.h"
+#include "pipeline/organ_motion.h"
 #include "pipeline/scene_stages.h"
 #include "render/render_volume.h"
 #include "report/slices.h"
@@ -355,6 +356,23 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
       }
       j["gas_in_prevesical_space_ml"] = double(prevesical) * w.voxel_volume_ml;
     }
+  }
+  // Where each labelled structure that may move went (pipeline/organ_motion.h): the wall's and the
+  // viscera's labels; what is fixed stays.
+  if (!w.result.labels.empty() && !w.roles.label.empty()) {
+    std::vector<int> moving = scene.roles.wall_labels;
+    moving.insert(moving.end(), scene.roles.viscera_labels.begin(), scene.roles.viscera_labels.end());
+    nlohmann::json organs = nlohmann::json::array();
+    for (const OrganMotion& o : organ_motion(w.roles.label, w.roles.geometry, w.result.labels, w.output_grid,
+                                             uint16_t(scene.output.cavity_label), scene.roles.label_names, moving))
+      organs.push_back({{"label", o.label},
+                        {"name", o.name},
+                        {"volume_ml", o.volume_ml},
+                        {"volume_change_fraction", o.volume_change},
+                        {"shift_right_mm", o.shift_mm[0]},
+                        {"shift_anterior_mm", o.shift_mm[1]},
+                        {"shift_superior_mm", o.shift_mm[2]}});
+    if (!organs.empty()) j["organ_motion"] = organs;
   }
   j["warp"] = {{"device", w.result.device},
                {"cavity_label", scene.output.cavity_label},

@@ -1,0 +1,63 @@
+// Where each labelled structure went (pipeline/organ_motion.h), against what a known motion gives:
+// a block of label 5 moved by whole voxels shifts its centroid by exactly that many millimetres and
+// keeps its volume; a block doubled along one axis on a grid of half the spacing there keeps its
+// centroid and doubles its volume (+100 %); the cavity's label, labels not asked for and labels under
+// min_ml are left out.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "pipeline/organ_motion.h"
+
+using namespace pneumo;
+
+namespace {
+
+Geometry grid(const Vec3& spacing) {
+  Geometry g;
+  g.dims = {20, 20, 20};
+  g.spacing_mm = spacing;
+  g.origin_mm = Vec3(-10, 4, 100);
+  return g;
+}
+
+void paint(std::vector<uint16_t>& v, const Geometry& g, Index3 lo, Index3 hi, uint16_t id) {
+  for (int64_t k = lo[2]; k <= hi[2]; ++k)
+    for (int64_t j = lo[1]; j <= hi[1]; ++j)
+      for (int64_t i = lo[0]; i <= hi[0]; ++i) v[std::size_t(g.linear_index(i, j, k))] = id;
+}
+
+}  // namespace
+
+TEST(OrganMotion, AMovedBlockShiftsByItsMotionAndKeepsItsVolume) {
+  const Geometry g = grid(Vec3(2, 2, 3));
+  std::vector<uint16_t> rest(std::size_t(g.voxel_count()), 0), moved = rest;
+  paint(rest, g, {2, 2, 2}, {7, 8, 9}, 5);
+  paint(moved, g, {4, 1, 7}, {9, 7, 14}, 5);   // +2, −1, +5 voxels
+  paint(rest, g, {15, 15, 15}, {17, 17, 17}, 250);
+  paint(moved, g, {15, 15, 15}, {18, 18, 18}, 250);
+  paint(rest, g, {0, 0, 0}, {9, 9, 0}, 3);   // 1.2 ml of a label not asked for
+  const auto m = organ_motion(rest, g, moved, g, 250, {{5, "liver"}}, {5, 250});
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_EQ(m[0].label, 5);
+  EXPECT_EQ(m[0].name, "liver");
+  EXPECT_DOUBLE_EQ(m[0].volume_ml, 6 * 7 * 8 * 12 / 1000.0);
+  EXPECT_NEAR(m[0].volume_change, 0.0, 1e-12);
+  EXPECT_NEAR((m[0].shift_mm - Vec3(4, -2, 15)).norm(), 0.0, 1e-9);
+}
+
+TEST(OrganMotion, ABlockStretchedOnAFinerGridDoublesItsVolumeAboutTheSameCentroid) {
+  const Geometry coarse = grid(Vec3(2, 2, 2));
+  Geometry fine = grid(Vec3(2, 1, 2));
+  fine.dims = {20, 40, 20};
+  fine.origin_mm = coarse.origin_mm - Vec3(0, 0.5, 0);   // the same box, voxels split along y
+  std::vector<uint16_t> rest(std::size_t(coarse.voxel_count()), 0), stretched(std::size_t(fine.voxel_count()), 0);
+  paint(rest, coarse, {5, 6, 5}, {9, 9, 9}, 7);          // y from 6 to 9: 4 coarse voxels, 8 mm
+  paint(stretched, fine, {5, 8, 5}, {9, 23, 9}, 7);      // 16 fine voxels, 16 mm, about the same centre
+  paint(rest, coarse, {0, 0, 0}, {0, 0, 0}, 9);          // 8 µl: under min_ml (0.1 ml here), left out
+  const auto m = organ_motion(rest, coarse, stretched, fine, 250, {}, {}, /*min_ml=*/0.1);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_TRUE(m[0].name.empty());
+  EXPECT_NEAR(m[0].volume_change, 1.0, 1e-12);
+  EXPECT_NEAR((m[0].shift_mm - Vec3(0, 0, 0)).norm(), 0.0, 1e-9) << m[0].shift_mm.transpose();
+}
