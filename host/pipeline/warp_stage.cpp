@@ -18,6 +18,7 @@
 #include "image/png.h"
 #include "pipeline/cavity_measures.h"
 #include "pipeline/organ_motion.h"
+#include "pipeline/skin_area.h"
 #include "pipeline/scene_stages.h"
 #include "render/render_volume.h"
 #include "report/slices.h"
@@ -373,6 +374,22 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
                         {"shift_anterior_mm", o.shift_mm[1]},
                         {"shift_superior_mm", o.shift_mm[2]}});
     if (!organs.empty()) j["organ_motion"] = organs;
+  }
+  // The wall's skin, stretched (pipeline/skin_area.h).
+  if (!w.roles.role.empty()) {
+    const PointMap map = w.point_map();
+    Index3 last;
+    for (int a = 0; a < 3; ++a) last[a] = w.roles.geometry.dims[a] - 1 - w.roles.pad.hi[a];
+    const SkinArea skin = wall_skin_area(w.roles.geometry, w.roles.role.data(), w.roles.pad.lo, last,
+                                         [&map](const Vec3& rest, Vec3& moved) {
+                                           const MappedPoint p = map.to_deformed(rest);
+                                           moved = p.point_mm;
+                                           return p.carried;
+                                         });
+    if (skin.faces > 0) {
+      j["wall_skin_area_cm2"] = skin.rest_mm2 / 100.0;
+      j["wall_skin_area_change_fraction"] = skin.change();
+    }
   }
   j["warp"] = {{"device", w.result.device},
                {"cavity_label", scene.output.cavity_label},

@@ -30,6 +30,8 @@ constexpr Entry kEntries[] = {
     {"mean_viscera_anterior_displacement_mm", "Mean anterior displacement of the viscera", "mm", "Result", 1},
     {"anterior_viscera_posterior_motion_mm", "Posterior motion of the anterior viscera", "mm", "Result", 1},
     {"viscera_volume_change_ml", "Change of the viscera's tissue volume", "ml", "Result", 1},
+    {"wall_skin_area_cm2", "The wall's skin at rest (anterior and lateral)", "cm²", "Result", 1},
+    {"wall_skin_area_change_fraction", "Growth of the wall's skin (patients: +15 %, Song 2006)", "%", "Result", 100},
     {"organ_motion.label", "Label", "", "Result", 1},
     {"organ_motion.name", "Structure", "", "Result", 1},
     {"organ_motion.volume_ml", "Volume at rest", "ml", "Result", 1},

@@ -1,0 +1,66 @@
+// The wall's skin area (pipeline/skin_area.h) against what a known motion gives: a block of wall in
+// air, 4 × 3 × 2 voxels of 2 × 3 × 4 mm (8 × 9 × 8 mm), has its six sides' area at rest; carried by
+// a uniform scaling s every area grows by s² exactly, by a translation not at all; faces
+// toward the padding outside the CT's box are no skin; corners the map does not carry stay put and
+// are counted.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "pipeline/skin_area.h"
+
+using namespace pneumo;
+
+namespace {
+
+struct Block {
+  Geometry g;
+  std::vector<Role> role;
+};
+
+Block block() {
+  Block b;
+  b.g.dims = {8, 7, 6};
+  b.g.spacing_mm = Vec3(2, 3, 4);
+  b.g.origin_mm = Vec3(-7, 12, 40);
+  b.role.assign(std::size_t(b.g.voxel_count()), Role::Other);
+  for (int64_t k = 2; k <= 3; ++k)
+    for (int64_t j = 2; j <= 4; ++j)
+      for (int64_t i = 2; i <= 5; ++i) b.role[std::size_t(b.g.linear_index(i, j, k))] = Role::Wall;
+  return b;
+}
+
+// Sides of the 8 × 9 × 8 mm block: 2(8·9 + 8·8 + 9·8) mm².
+constexpr double kBlockMm2 = 2.0 * (8 * 9 + 8 * 8 + 9 * 8);
+
+}  // namespace
+
+TEST(SkinArea, ScaledBySGrowsBySSquaredAndMovedNotAtAll) {
+  const Block b = block();
+  const Vec3 centre(1.0, 20.0, 50.0);
+  const SkinArea scaled = wall_skin_area(b.g, b.role.data(), {0, 0, 0}, {-1, -1, -1}, [&](const Vec3& p, Vec3& q) {
+    q = centre + 1.1 * (p - centre);
+    return true;
+  });
+  EXPECT_EQ(scaled.faces, 2 * (4 * 3 + 4 * 2 + 3 * 2));
+  EXPECT_NEAR(scaled.rest_mm2, kBlockMm2, 1e-9);
+  EXPECT_NEAR(scaled.change(), 1.1 * 1.1 - 1.0, 1e-12);
+  EXPECT_EQ(scaled.corners_not_carried, 0);
+  const SkinArea moved = wall_skin_area(b.g, b.role.data(), {0, 0, 0}, {-1, -1, -1}, [](const Vec3& p, Vec3& q) {
+    q = p + Vec3(3, -2, 7);
+    return true;
+  });
+  EXPECT_NEAR(moved.change(), 0.0, 1e-12);
+}
+
+TEST(SkinArea, FacesTowardThePaddingAreNoSkinAndUncarriedCornersStay) {
+  const Block b = block();
+  // The CT's box ends at k = 3: the block's top faces (k = 3 → 4) face the padding above it.
+  const SkinArea cut = wall_skin_area(b.g, b.role.data(), {0, 0, 0}, {-1, -1, 3}, [](const Vec3& p, Vec3& q) {
+    q = p;
+    return false;
+  });
+  EXPECT_NEAR(cut.rest_mm2, kBlockMm2 - 8 * 9, 1e-9);
+  EXPECT_NEAR(cut.change(), 0.0, 1e-12);
+  EXPECT_GT(cut.corners_not_carried, 0);
+}
