@@ -58,7 +58,6 @@ Mesh slab(const SlabOptions& o = {}) {
   MeshOptions mo;
   mo.cube_voxels = L;
   mo.model = MeshModel::Wall;
-  mo.cut_faces = CutFaces::Free;   // the slab fills the grid: its ends are no cut body (test_cut_faces.cpp)
   Mesh m = build_mesh(VoxelRoles{g, roles.data(), nullptr}, mo, [&](Role, int) { return o.young_pa; });
   assign_material(m, MaterialOptions{kRho, o.damping_ratio, 1.0});
   return m;
@@ -403,7 +402,6 @@ TEST(ExtremeMesh, OneCube) {
   const Role wall = Role::Wall;
   MeshOptions mo;
   mo.cube_voxels = 1;
-  mo.cut_faces = CutFaces::Free;   // a free cube, not one cut from a body (test_cut_faces.cpp)
   Mesh cube = build_mesh(VoxelRoles{g, &wall, nullptr}, mo, [](Role, int) { return 60e3; });
   assign_material(cube, MaterialOptions{});
   ASSERT_EQ(cube.node_count(), 8);

@@ -40,7 +40,6 @@ Mesh build(const Voxels& v, int L, MeshModel model = MeshModel::Wall, std::optio
   o.model = model;
   o.roi_min_mm = roi_min;
   o.roi_max_mm = roi_max;
-  o.cut_faces = CutFaces::Free;   // blocks that fill the grid: their ends are no cut body (test_cut_faces.cpp)
   return build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr}, o, [](Role, int) { return kYoungPa; });
 }
 

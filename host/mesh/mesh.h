@@ -72,8 +72,10 @@ struct MeshOptions {
   /// and lateral face of the CT's box (VoxelRoles::ct_first/ct_last) that cuts tissue on the face's
   /// normal (world z or x) and leaves them free within it, as a symmetry plane does: the body beyond is taken as the mirror image of the body
   /// inside, so the wall's cut edge neither lifts like a flap nor lets gas or viscera out
-  /// (docs/fidelity.md, "Cut faces"). Free leaves them free, as a real edge of tissue would be.
-  CutFaces cut_faces = CutFaces::Slide;
+  /// (docs/fidelity.md, "Cut faces"). Free leaves them free, as a real edge of tissue would be, and
+  /// is the default here: a mesh built from voxels that are no CT (a test block, a validation) has no
+  /// cut; scenes default to Slide (SceneMesh::cut_faces).
+  CutFaces cut_faces = CutFaces::Free;
 };
 
 struct Mesh;

@@ -187,17 +187,20 @@ uint8_t world_hold_of(const Geometry& g, int a) {
   return std::abs(g.direction(w, a)) >= std::cos(1.0 * 3.14159265358979323846 / 180.0) ? uint8_t(1 << w) : 0;
 }
 
-/// Whether the CT's boundary slice `slice` along `axis` holds tissue (any role but other) in the cubes
-/// around the lattice node `n`: the CT cuts the body there.
+/// Whether the CT's boundary slice `slice` along `axis` holds tissue the mesh meshes (wall, and viscera
+/// with `viscera`) in the cubes around the lattice node `n`: the CT cuts the body there.
 bool cut_through_tissue(const VoxelRoles& roles, const std::array<int64_t, 3>& n, int axis, int64_t slice,
-                        const CubeVoxels& L) {
+                        const CubeVoxels& L, bool viscera) {
   const Geometry& g = roles.geometry;
   const int u = (axis + 1) % 3, w = (axis + 2) % 3;
   std::array<int64_t, 3> v{};
   v[axis] = slice;
   for (v[w] = std::max<int64_t>(0, (n[w] - 1) * L[w]); v[w] < std::min(g.dims[w], (n[w] + 1) * L[w]); ++v[w])
     for (v[u] = std::max<int64_t>(0, (n[u] - 1) * L[u]); v[u] < std::min(g.dims[u], (n[u] + 1) * L[u]); ++v[u])
-      if (roles.role[g.linear_index(v[0], v[1], v[2])] != Role::Other) return true;
+    {
+      const Role r = roles.role[g.linear_index(v[0], v[1], v[2])];
+      if (r == Role::Wall || (viscera && r == Role::Viscera)) return true;
+    }
   return false;
 }
 
@@ -720,10 +723,11 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
       if (!bit || bit == kHoldY) continue;
       const int64_t first = std::clamp<int64_t>(roles.ct_first[axis], 0, g.dims[axis] - 1);
       const int64_t last = roles.ct_last[axis] < 0 ? g.dims[axis] - 1 : std::clamp<int64_t>(roles.ct_last[axis], first, g.dims[axis] - 1);
-      // A face between voxels b − 1 and b lies on lattice plane b / L.
-      const struct { int64_t slice, plane; } faces[2] = {
-          {first, std::clamp<int64_t>((2 * first + L[axis]) / (2 * L[axis]), 0, lat.cubes[axis])},
-          {last, std::clamp<int64_t>((2 * (last + 1) + L[axis]) / (2 * L[axis]), 0, lat.cubes[axis])}};
+      // A face between voxels b − 1 and b lies on lattice plane b / L; the nearest plane, a tie going
+      // outwards (below the low face, above the high one), so no CT tissue is left beyond it by more
+      // than half a cube.
+      const struct { int64_t slice, plane; } faces[2] = {{first, (2 * first + L[axis] - 1) / (2 * L[axis])},
+                                                         {last, (2 * (last + 1) + L[axis]) / (2 * L[axis])}};
       for (const auto& face : faces) {
         std::array<int64_t, 3> n{};
         n[axis] = face.plane;
@@ -732,9 +736,9 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
           for (n[u] = 0; n[u] <= lat.cubes[u]; ++n[u]) {
             const int64_t ni = lat.node_index(n[0], n[1], n[2]);
             if (node_id[0][ni] < 0 && node_id[1][ni] < 0) continue;
-            if (!cut_through_tissue(roles, n, axis, face.slice, L)) continue;
+            if (!cut_through_tissue(roles, n, axis, face.slice, L, with_viscera)) continue;
             for (int p = 0; p < kParts; ++p)
-              if (node_id[p][ni] >= 0 && m.hold[node_id[p][ni]] != kHoldAll) m.hold[node_id[p][ni]] |= bit;
+              if (node_id[p][ni] >= 0) m.hold[node_id[p][ni]] |= bit;
           }
       }
     }

@@ -21,7 +21,6 @@ LatticeResult validate_lattice(int n, double cube_mm) {
   MeshOptions mo;
   mo.cube_voxels = 1;
   mo.model = MeshModel::Wall;
-  mo.cut_faces = CutFaces::Free;   // a free block, its holds set below: its faces cut no body
   Mesh m = build_mesh(VoxelRoles{g, roles.data(), nullptr}, mo, [&](Role, int) { return E; });
   assign_material(m, MaterialOptions{});
 
