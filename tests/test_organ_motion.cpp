@@ -34,8 +34,8 @@ TEST(OrganMotion, AMovedBlockShiftsByItsMotionAndKeepsItsVolume) {
   std::vector<uint16_t> rest(std::size_t(g.voxel_count()), 0), moved = rest;
   paint(rest, g, {2, 2, 2}, {7, 8, 9}, 5);
   paint(moved, g, {4, 1, 7}, {9, 7, 14}, 5);   // +2, −1, +5 voxels
-  paint(rest, g, {15, 15, 15}, {17, 17, 17}, 250);
-  paint(moved, g, {15, 15, 15}, {18, 18, 18}, 250);
+  paint(rest, g, {13, 13, 13}, {17, 17, 17}, 250);      // 1.5 ml of gas, asked for and still left out
+  paint(moved, g, {13, 13, 13}, {18, 18, 18}, 250);
   paint(rest, g, {0, 0, 0}, {9, 9, 0}, 3);   // 1.2 ml of a label not asked for
   const auto m = organ_motion(rest, g, moved, g, 250, {{5, "liver"}}, {5, 250});
   ASSERT_EQ(m.size(), 1u);
@@ -55,7 +55,8 @@ TEST(OrganMotion, ABlockStretchedOnAFinerGridDoublesItsVolumeAboutTheSameCentroi
   paint(rest, coarse, {5, 6, 5}, {9, 9, 9}, 7);          // y from 6 to 9: 4 coarse voxels, 8 mm
   paint(stretched, fine, {5, 8, 5}, {9, 23, 9}, 7);      // 16 fine voxels, 16 mm, about the same centre
   paint(rest, coarse, {0, 0, 0}, {0, 0, 0}, 9);          // 8 µl: under min_ml (0.1 ml here), left out
-  const auto m = organ_motion(rest, coarse, stretched, fine, 250, {}, {}, /*min_ml=*/0.1);
+  EXPECT_TRUE(organ_motion(rest, coarse, stretched, fine, 250, {}, {}, 0.1).empty());   // no ids, none
+  const auto m = organ_motion(rest, coarse, stretched, fine, 250, {}, {7, 9}, /*min_ml=*/0.1);
   ASSERT_EQ(m.size(), 1u);
   EXPECT_TRUE(m[0].name.empty());
   EXPECT_NEAR(m[0].volume_change, 1.0, 1e-12);

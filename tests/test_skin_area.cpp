@@ -1,8 +1,8 @@
 // The wall's skin area (pipeline/skin_area.h) against what a known motion gives: a block of wall in
 // air, 4 × 3 × 2 voxels of 2 × 3 × 4 mm (8 × 9 × 8 mm), has its six sides' area at rest; carried by
-// a uniform scaling s every area grows by s² exactly, by a translation not at all; faces
-// toward the padding outside the CT's box are no skin; corners the map does not carry stay put and
-// are counted.
+// a uniform scaling s every area grows by s² exactly, by a translation not at all; faces toward the
+// padding outside the CT's box, or toward tissue left out inside the body, are no skin; corners the
+// map does not carry stay put and are counted.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -16,17 +16,30 @@ namespace {
 struct Block {
   Geometry g;
   std::vector<Role> role;
+  std::vector<uint8_t> body;   // the block, and with `hollow` an air voxel of it, in the body
+  VoxelRoles view(Index3 last = {-1, -1, -1}) const {
+    VoxelRoles v{g, role.data()};
+    v.ct_last = last;
+    return v;
+  }
 };
 
-Block block() {
+/// Wall voxels i 2…5, j 2…4, k 2…3; with `hollow`, voxel (6, 3, 2) beside it is air inside the body
+/// (tissue the roles left out), its face toward the block no skin.
+Block block(bool hollow = false) {
   Block b;
   b.g.dims = {8, 7, 6};
   b.g.spacing_mm = Vec3(2, 3, 4);
   b.g.origin_mm = Vec3(-7, 12, 40);
   b.role.assign(std::size_t(b.g.voxel_count()), Role::Other);
+  b.body.assign(b.role.size(), 0);
   for (int64_t k = 2; k <= 3; ++k)
     for (int64_t j = 2; j <= 4; ++j)
-      for (int64_t i = 2; i <= 5; ++i) b.role[std::size_t(b.g.linear_index(i, j, k))] = Role::Wall;
+      for (int64_t i = 2; i <= 5; ++i) {
+        b.role[std::size_t(b.g.linear_index(i, j, k))] = Role::Wall;
+        b.body[std::size_t(b.g.linear_index(i, j, k))] = 1;
+      }
+  if (hollow) b.body[std::size_t(b.g.linear_index(6, 3, 2))] = 1;
   return b;
 }
 
@@ -38,7 +51,7 @@ constexpr double kBlockMm2 = 2.0 * (8 * 9 + 8 * 8 + 9 * 8);
 TEST(SkinArea, ScaledBySGrowsBySSquaredAndMovedNotAtAll) {
   const Block b = block();
   const Vec3 centre(1.0, 20.0, 50.0);
-  const SkinArea scaled = wall_skin_area(b.g, b.role.data(), {0, 0, 0}, {-1, -1, -1}, [&](const Vec3& p, Vec3& q) {
+  const SkinArea scaled = wall_skin_area(b.view(), b.body, [&](const Vec3& p, Vec3& q) {
     q = centre + 1.1 * (p - centre);
     return true;
   });
@@ -46,21 +59,33 @@ TEST(SkinArea, ScaledBySGrowsBySSquaredAndMovedNotAtAll) {
   EXPECT_NEAR(scaled.rest_mm2, kBlockMm2, 1e-9);
   EXPECT_NEAR(scaled.change(), 1.1 * 1.1 - 1.0, 1e-12);
   EXPECT_EQ(scaled.corners_not_carried, 0);
-  const SkinArea moved = wall_skin_area(b.g, b.role.data(), {0, 0, 0}, {-1, -1, -1}, [](const Vec3& p, Vec3& q) {
+  const SkinArea moved = wall_skin_area(b.view(), b.body, [](const Vec3& p, Vec3& q) {
     q = p + Vec3(3, -2, 7);
     return true;
   });
   EXPECT_NEAR(moved.change(), 0.0, 1e-12);
 }
 
-TEST(SkinArea, FacesTowardThePaddingAreNoSkinAndUncarriedCornersStay) {
+TEST(SkinArea, UncarriedCornersStayWhereTheyWere) {
+  // A map that carries nothing (and writes nonsense where it fails): every one of the block's 54
+  // surface corners (5 × 4 × 3 less the 6 inside) stays put, so the area does not change.
   const Block b = block();
-  // The CT's box ends at k = 3: the block's top faces (k = 3 → 4) face the padding above it.
-  const SkinArea cut = wall_skin_area(b.g, b.role.data(), {0, 0, 0}, {-1, -1, 3}, [](const Vec3& p, Vec3& q) {
-    q = p;
+  const SkinArea none = wall_skin_area(b.view(), b.body, [](const Vec3& p, Vec3& q) {
+    q = p + Vec3(50, 0, 0);
     return false;
   });
-  EXPECT_NEAR(cut.rest_mm2, kBlockMm2 - 8 * 9, 1e-9);
-  EXPECT_NEAR(cut.change(), 0.0, 1e-12);
-  EXPECT_GT(cut.corners_not_carried, 0);
+  EXPECT_EQ(none.corners_not_carried, 54);
+  EXPECT_NEAR(none.change(), 0.0, 1e-12);
+}
+
+TEST(SkinArea, FacesTowardThePaddingOrTissueInsideTheBodyAreNoSkin) {
+  // The CT's box ends at k = 3: the block's top (8 × 9 mm) faces the padding above it. A voxel of air
+  // inside the body beside the block hides one 3 × 4 mm face.
+  const Block b = block(/*hollow=*/true);
+  auto still = [](const Vec3& p, Vec3& q) {
+    q = p;
+    return true;
+  };
+  EXPECT_NEAR(wall_skin_area(b.view(), b.body, still).rest_mm2, kBlockMm2 - 3 * 4, 1e-9);
+  EXPECT_NEAR(wall_skin_area(b.view({-1, -1, 3}), b.body, still).rest_mm2, kBlockMm2 - 3 * 4 - 8 * 9, 1e-9);
 }

@@ -2,6 +2,8 @@
 
 #include <array>
 
+#include "domain/label_set.h"
+
 namespace pneumo {
 
 namespace {
@@ -33,14 +35,13 @@ std::vector<OrganMotion> organ_motion(const std::vector<uint16_t>& rest, const G
   std::vector<OrganMotion> out;
   if (int64_t(rest.size()) != rest_grid.voxel_count() || int64_t(deformed.size()) != deformed_grid.voxel_count())
     return out;
-  std::vector<uint8_t> wanted(65536, ids.empty() ? 1 : 0);
-  for (int id : ids)
-    if (id > 0 && id < 65536) wanted[std::size_t(id)] = 1;
+  if (ids.empty()) return out;
+  const LabelSet wanted(ids);
   const std::vector<Sums> before = sums_of(rest, rest_grid), after = sums_of(deformed, deformed_grid);
   const double ml_before = rest_grid.spacing_mm.prod() / 1000.0, ml_after = deformed_grid.spacing_mm.prod() / 1000.0;
   for (int id = 1; id < 65536; ++id) {
     const Sums& b = before[std::size_t(id)];
-    if (id == skip || !wanted[std::size_t(id)] || double(b.count) * ml_before < min_ml) continue;
+    if (id == skip || !wanted.contains(id) || double(b.count) * ml_before < min_ml) continue;
     const Sums& a = after[std::size_t(id)];
     OrganMotion m;
     m.label = id;

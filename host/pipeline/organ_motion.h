@@ -23,11 +23,11 @@ struct OrganMotion {
   Vec3 shift_mm = Vec3::Zero();  // deformed centroid − rest centroid, world RAS
 };
 
-/// The labels `ids` (every label when empty) of `rest` (on `rest_grid`) of at least `min_ml`, except 0
-/// and `skip` (the cavity's label), against `deformed` (on `deformed_grid`), in increasing label order.
+/// The labels `ids` of `rest` (on `rest_grid`) of at least `min_ml`, except 0 and `skip` (the cavity's
+/// label), against `deformed` (on `deformed_grid`), in increasing label order; none when `ids` is empty.
 std::vector<OrganMotion> organ_motion(const std::vector<uint16_t>& rest, const Geometry& rest_grid,
                                       const std::vector<uint16_t>& deformed, const Geometry& deformed_grid,
                                       uint16_t skip, const std::map<int, std::string>& names,
-                                      const std::vector<int>& ids = {}, double min_ml = 1.0);
+                                      const std::vector<int>& ids, double min_ml = 1.0);
 
 }  // namespace pneumo

@@ -4,14 +4,15 @@
 
 namespace pneumo {
 
-SkinArea wall_skin_area(const Geometry& g, const Role* role, const Index3& ct_first, const Index3& ct_last,
-                        const CarryFn& carry) {
+SkinArea wall_skin_area(const VoxelRoles& roles, const std::vector<uint8_t>& body, const CarryFn& carry) {
   SkinArea s;
+  const Geometry& g = roles.geometry;
+  const Role* role = roles.role;
   Index3 last;
-  for (int a = 0; a < 3; ++a) last[a] = ct_last[a] < 0 ? g.dims[a] - 1 : ct_last[a];
+  for (int a = 0; a < 3; ++a) last[a] = roles.ct_last[a] < 0 ? g.dims[a] - 1 : roles.ct_last[a];
   auto in_box = [&](const Index3& v) {
     for (int a = 0; a < 3; ++a)
-      if (v[a] < ct_first[a] || v[a] > last[a]) return false;
+      if (v[a] < roles.ct_first[a] || v[a] > last[a]) return false;
     return true;
   };
   // Corners are voxel corners, keyed by their doubled index (2i + 1 for the corner at i + ½), carried once.
@@ -42,7 +43,8 @@ SkinArea wall_skin_area(const Geometry& g, const Role* role, const Index3& ct_fi
             Index3 n = v;
             n[axis] += side;
             if (n[axis] < 0 || n[axis] >= g.dims[axis] || !in_box(n)) continue;
-            if (role[g.linear_index(n[0], n[1], n[2])] != Role::Other) continue;
+            const int64_t o = g.linear_index(n[0], n[1], n[2]);
+            if (role[o] != Role::Other || body[std::size_t(o)]) continue;
             // The face's corners in doubled index coordinates, in cyclic order.
             const int u = (axis + 1) % 3, w = (axis + 2) % 3;
             Index3 c[4];

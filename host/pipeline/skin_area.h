@@ -1,14 +1,17 @@
 #pragma once
 // The wall's skin before and after the inflation (issue "The abdomen expands as patients' does", item
 // 5): Song et al. 2006 (Surg Endosc, 18 patients, 12 mmHg) measured the abdominal wall's area growing by
-// 15 %. The skin here is every face between a wall voxel and air inside the CT's own box (faces toward
-// the padding around it, where the CT cut the body, are no skin); each face's corners are carried
-// through the deformation and its deformed area is that of the two triangles they span.
+// 15 %. The skin here is every face between a wall voxel and the air outside the body within the CT's
+// own box (faces toward the padding around it, where the CT cut the body, are no skin; nor are faces
+// toward tissue left out inside the body); each face's corners are carried through the deformation
+// and its deformed area is that of the two triangles they span.
 #include <cstdint>
 #include <functional>
 
+#include <vector>
+
 #include "core/geometry.h"
-#include "domain/types.h"
+#include "mesh/mesh.h"
 
 namespace pneumo {
 
@@ -22,9 +25,9 @@ struct SkinArea {
 /// A point of the original frame (world mm) carried to the deformed one; false where it is not.
 using CarryFn = std::function<bool(const Vec3& original_mm, Vec3& deformed_mm)>;
 
-/// The skin of the wall voxels of `role` (one per voxel of `g`) whose air neighbour lies within the
-/// CT's box `ct_first`..`ct_last` (a last of -1: the grid's last), at rest and carried by `carry`.
-SkinArea wall_skin_area(const Geometry& g, const Role* role, const Index3& ct_first, const Index3& ct_last,
-                        const CarryFn& carry);
+/// The skin of the wall voxels of `roles` whose neighbour is outside `body` (one per voxel; 1 inside,
+/// anatomy/body_mask.h) and within the CT's box (VoxelRoles::ct_first/ct_last), at rest and carried by
+/// `carry`.
+SkinArea wall_skin_area(const VoxelRoles& roles, const std::vector<uint8_t>& body, const CarryFn& carry);
 
 }  // namespace pneumo

@@ -16,6 +16,7 @@
 #include "io/itk_transform_io.h"
 #include "io/volume_io.h"
 #include "image/png.h"
+#include "anatomy/body_mask.h"
 #include "pipeline/cavity_measures.h"
 #include "pipeline/organ_motion.h"
 #include "pipeline/skin_area.h"
@@ -317,6 +318,12 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
   // The outcomes, not the HU: a run hands the HU to the renderer before the metrics are written.
   const double mvox_s = w.seconds_warp > 0 ? double(w.result.outcome.size()) / w.seconds_warp / 1e6 : 0.0;
   nlohmann::json j;
+  // Points through the deformation, for the prevesical gas and the skin: binned once, when first asked.
+  std::optional<PointMap> map;
+  auto point_map = [&]() -> const PointMap& {
+    if (!map) map.emplace(w.warp_mesh, w.roles.role.data());
+    return *map;
+  };
   j["deformed_body_outside_grid_mm"] = w.outside_grid_mm;
   j["cavity_voxels"] = w.cavity_voxels();
   j["cavity_volume_ml"] = w.cavity_volume_ml();
@@ -345,12 +352,12 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
       j["gas_short_of_intraperitoneal_organs_ml"] = double(short_of_organs) * w.voxel_volume_ml;
       int64_t prevesical = 0;
       if (short_of_organs > 0) {
-        const PointMap map = w.point_map();
+        const PointMap& to_rest = point_map();
         RestColumns rest;
         rest.labels = w.roles.label.empty() ? nullptr : w.roles.label.data();
         rest.grid = w.roles.geometry;
-        rest.to_rest = [&map](const Vec3& deformed_mm) -> std::optional<Vec3> {
-          const MappedPoint p = map.to_original(deformed_mm);
+        rest.to_rest = [&to_rest](const Vec3& deformed_mm) -> std::optional<Vec3> {
+          const MappedPoint p = to_rest.to_original(deformed_mm);
           return p.carried ? std::optional<Vec3>(p.point_mm) : std::nullopt;
         };
         prevesical = gas_voxels_anterior_to(w.result.labels, w.output_grid, gas_id, bladder, organs, &rest);
@@ -376,16 +383,14 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
     if (!organs.empty()) j["organ_motion"] = organs;
   }
   // The wall's skin, stretched (pipeline/skin_area.h).
-  if (!w.roles.role.empty()) {
-    const PointMap map = w.point_map();
-    Index3 last;
-    for (int a = 0; a < 3; ++a) last[a] = w.roles.geometry.dims[a] - 1 - w.roles.pad.hi[a];
-    const SkinArea skin = wall_skin_area(w.roles.geometry, w.roles.role.data(), w.roles.pad.lo, last,
-                                         [&map](const Vec3& rest, Vec3& moved) {
-                                           const MappedPoint p = map.to_deformed(rest);
-                                           moved = p.point_mm;
-                                           return p.carried;
-                                         });
+  if (!w.roles.role.empty() && w.roles.hu()) {
+    const PointMap& to_deformed = point_map();
+    const std::vector<uint8_t> body = body_mask(w.roles.hu(), w.roles.geometry, scene.roles.auto_body_threshold_hu);
+    const SkinArea skin = wall_skin_area(voxel_roles_of(w.roles), body, [&to_deformed](const Vec3& rest, Vec3& moved) {
+      const MappedPoint p = to_deformed.to_deformed(rest);
+      moved = p.point_mm;
+      return p.carried;
+    });
     if (skin.faces > 0) {
       j["wall_skin_area_cm2"] = skin.rest_mm2 / 100.0;
       j["wall_skin_area_change_fraction"] = skin.change();
