@@ -300,6 +300,8 @@ NiftiExtensions read_nifti_extensions(const std::string& path) {
   if (out.swapped) nifti_swap_as_nifti1(&h);
   // The 4 bytes after the header: extension[0] != 0 when extensions follow, up to vox_offset.
   constexpr uint64_t kMaxExtensionBytes = 16u << 20;   // 65,536 long label names fit in far less
+  if (!(h.vox_offset >= 0.0f && h.vox_offset <= float(352 + (64u << 20))))   // NaN, negative or absurd
+    throw file_error(path, "vox_offset " + std::to_string(h.vox_offset) + " is not a data offset");
   const uint64_t end = uint64_t(h.vox_offset);
   if (end <= 352) return out;
   if (end - 352 > kMaxExtensionBytes)
