@@ -77,6 +77,7 @@ TEST(ScanCoverage, CroppedThroughTheLiversMiddleTheLungsAreGone) {
   const Case lower{crop_slices(ct, 0, cut), crop_slices(labels, 0, cut)};
   const ScanCoverage c = coverage_of(lower);
   EXPECT_TRUE(has(c.top.structures, "liver")) << c.summary;
+  EXPECT_FALSE(c.lungs_in_view) << c.summary;
   EXPECT_TRUE(warns_of(c, "cuts the liver")) << c.summary;
   EXPECT_TRUE(c.pelvis_in_view);
 }
