@@ -34,6 +34,21 @@ TEST(OwnedFolder, OnlyAFolderPneumoMadeIsRemoved) {
   EXPECT_NO_THROW(check_owned_or_absent(mine));   // absent: pneumo may make it
 }
 
+TEST(OwnedFolder, AnEmptyFolderIsTakenAndMarked) {
+  // A run killed between making views/ and marking it leaves it empty (the full test suite caught
+  // one: KillDuringRun). Nothing in it can be lost, so the next run takes it; one hidden file of the
+  // user's makes it theirs again.
+  ScratchDir d;
+  const fs::path empty = d.file("views"), hidden = d.file("flythrough");
+  fs::create_directories(empty);
+  EXPECT_NO_THROW(check_owned_or_absent(empty));
+  create_owned_folder(empty);
+  EXPECT_TRUE(is_owned_folder(empty));
+  fs::create_directories(hidden);
+  std::ofstream(hidden / ".notes") << "mine";
+  EXPECT_THROW(check_owned_or_absent(hidden), InputError);
+}
+
 TEST(OwnedFolder, ALinkToAUsersFolderIsNotPneumos) {
   // The marker is looked for in the folder itself, not through a link to another one that has it.
   ScratchDir d;

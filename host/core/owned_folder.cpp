@@ -15,6 +15,9 @@ bool is_owned_folder(const fs::path& dir) {
 void check_owned_or_absent(const fs::path& dir) {
   std::error_code ec;
   if (!fs::exists(fs::symlink_status(dir, ec)) || is_owned_folder(dir)) return;
+  // An empty folder holds nothing to lose: a run killed between making its folder and marking it
+  // leaves one (the marker's own temporary is removed by the output lock), and the next run takes it.
+  if (fs::is_directory(fs::symlink_status(dir, ec)) && fs::is_empty(dir, ec) && !ec) return;
   throw file_error(dir.string(), std::string("is not a folder pneumo made (it has no ") + kOwnedFolderMarker +
                                      "), and pneumo writes its own there; move it or choose another --out");
 }

@@ -17,8 +17,8 @@ void create_owned_folder(const std::filesystem::path& dir);
 /// Whether `dir` is a folder pneumo made (it holds the marker).
 bool is_owned_folder(const std::filesystem::path& dir);
 
-/// Throws InputError naming `dir` when it exists but pneumo did not make it: pneumo would otherwise
-/// write into, or remove, a folder of the user's.
+/// Throws InputError naming `dir` when it exists, is not empty and pneumo did not make it: pneumo would
+/// otherwise write into, or remove, a folder of the user's. An empty folder is taken (nothing to lose).
 void check_owned_or_absent(const std::filesystem::path& dir);
 
 /// Removes `dir` with everything in it if pneumo made it; a folder of the user's is left as it is
