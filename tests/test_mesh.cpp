@@ -533,5 +533,38 @@ TEST(MeshTissue, ModulusIsHillsMeanOfTheVoxelsInEachTetrahedron) {
   for (double e : no_ct.tet_young_pa) EXPECT_DOUBLE_EQ(e, 60e3);
 }
 
+TEST(MeshTissue, PoissonsRatioIsTheMeanOfTheVoxelsInEachTetrahedron) {
+  // Compared: the same cube, lower half lung (HU −800 → ν 0.40), upper half muscle (ν 0.45), with
+  // MeshOptions::poisson_for: each tetrahedron's ν is the mean over the voxel centres it holds, derived
+  // here from the points alone; all lung gives 0.40 exactly. Without poisson_for the mesh leaves
+  // tet_poisson to its caller (empty).
+  Voxels v(4, 4, 4, 1.0, Role::Wall);
+  std::vector<float> hu(v.roles.size());
+  for (int64_t k = 0; k < 4; ++k)
+    for (int64_t j = 0; j < 4; ++j)
+      for (int64_t i = 0; i < 4; ++i) hu[v.g.linear_index(i, j, k)] = k < 2 ? -800.0f : 50.0f;
+  const VoxelYoungFn young = [](Role, int, float h) { return h <= -400.0f ? 1e3 : 60e3; };
+  MeshOptions o;
+  o.cube_voxels = 4;
+  o.model = MeshModel::Wall;
+  EXPECT_TRUE(build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}, o, young).tet_poisson.empty());
+  o.poisson_for = [](Role, int, float h) { return h <= -400.0f ? 0.40 : 0.45; };
+  const Mesh half = build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}, o, young);
+  ASSERT_EQ(half.tet_poisson.size(), 5u);
+  double sum[5] = {0, 0, 0, 0, 0};
+  int n[5] = {0, 0, 0, 0, 0};
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const int t = lattice::tet_holding({(i + 0.5) / 4, (j + 0.5) / 4, (k + 0.5) / 4}, false);
+        sum[t] += k < 2 ? 0.40 : 0.45;
+        ++n[t];
+      }
+  for (int t = 0; t < 5; ++t) EXPECT_NEAR(half.tet_poisson[t], sum[t] / n[t], 1e-12) << "tetrahedron " << t;
+  std::fill(hu.begin(), hu.end(), -800.0f);
+  for (double nu : build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}, o, young).tet_poisson)
+    EXPECT_DOUBLE_EQ(nu, 0.40);
+}
+
 }  // namespace
 }  // namespace pneumo

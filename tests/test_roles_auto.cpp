@@ -251,7 +251,10 @@ TEST(RolesAuto, FindsThePhantomsWallWithoutWallLabels) {
   const Phantom ph = make_phantom(PhantomSize::Small);
   const Scene labelled = parse_scene(nlohmann::json::parse(phantom_scene_json(PhantomSize::Small)), "");
   const std::vector<int> wall_ids = labelled.roles.wall_labels;
-  const auto is_wall_label = [&](int id) { return std::find(wall_ids.begin(), wall_ids.end(), id) != wall_ids.end(); };
+  // The lungs (11, 14) are wall too: compliant (roles.compliant_lungs), whether labelled or found by density.
+  const auto is_wall_label = [&](int id) {
+    return id == 11 || id == 14 || std::find(wall_ids.begin(), wall_ids.end(), id) != wall_ids.end();
+  };
   constexpr int kDiaphragm = 207;   // wall by label, but deep inside: no shell can reach it
   for (const bool use_labels : {false, true}) {
     Scene s = labelled;

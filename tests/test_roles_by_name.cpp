@@ -38,7 +38,10 @@ TEST(RolesByName, AnInputsOnlySceneGetsTheHandChosenLists) {
   for (const auto& [id, name] : read_label_names(totalseg_dir() + "/labels.csv")) present.insert(id);
   EXPECT_EQ(s.roles.source, RoleSource::Auto);
   EXPECT_EQ(ids_present(s.roles.viscera_labels, present), kHandViscera);
-  EXPECT_EQ(ids_present(s.roles.wall_labels, present), kHandWall);
+  std::vector<int> wall = kHandWall;   // and the lungs, compliant by default
+  wall.insert(wall.end(), kHandLungs.begin(), kHandLungs.end());
+  std::sort(wall.begin(), wall.end());
+  EXPECT_EQ(ids_present(s.roles.wall_labels, present), wall);
   EXPECT_EQ(ids_present(s.mesh.attached_labels, present), kHandWall);
   EXPECT_EQ(s.roles.auto_prevesical_labels, std::vector<int>{21});
   for (int id : kHandFixed)
@@ -69,8 +72,10 @@ TEST(RolesByName, VoxelsGetTheRolesOfTheHandWrittenScene) {
   const Volume ct = read_volume(example_ct_path());
   const Volume labels = read_volume(example_labels_path());
   nlohmann::json by_hand = inputs_only(example_labels_path());
+  std::vector<int> wall = kHandWall;   // and the lungs, compliant by default
+  wall.insert(wall.end(), kHandLungs.begin(), kHandLungs.end());
   by_hand["roles"] = {{"by_name", false}, {"auto_prevesical_labels", {21}}, {"viscera_labels", kHandViscera},
-                      {"wall_labels", kHandWall}, {"fixed_labels", kHandFixed}};
+                      {"wall_labels", wall}, {"fixed_labels", kHandFixed}};
   const RoleVolume hand = assign_roles(scene_of(by_hand), ct, &labels);
   const RoleVolume named = assign_roles(scene_of(inputs_only(example_labels_path())), ct, &labels);
   EXPECT_TRUE(hand.role == named.role);

@@ -84,12 +84,13 @@ TEST(RolesRealCT, RoleVolumesAreThoseOfAnAdultAbdomen) {
 TEST(RolesRealCT, OrgansAreVisceraAndTheSpineIsFixed) {
   PNEUMO_REQUIRE_REAL_CT();
   const RoleVolume& rv = real_roles();
-  int64_t liver = 0, vertebrae = 0;
+  int64_t liver = 0, liver_wall = 0, vertebrae = 0;
   for (std::size_t n = 0; n < rv.role.size(); ++n) {
     const int id = rv.label[n];
-    if (id == 5) {   // liver: entirely viscera
+    if (id == 5) {   // liver: viscera, but for the diaphragm rule 5c takes from it under a lung
       ++liver;
-      ASSERT_EQ(rv.role[n], Role::Viscera) << "liver voxel " << n;
+      ASSERT_NE(rv.role[n], Role::Fixed) << "liver voxel " << n;
+      liver_wall += rv.role[n] == Role::Wall;
     }
     if (id >= 25 && id <= 33) {   // sacrum, S1, L5..T11: entirely fixed
       ++vertebrae;
@@ -97,6 +98,11 @@ TEST(RolesRealCT, OrgansAreVisceraAndTheSpineIsFixed) {
     }
   }
   EXPECT_EQ(liver, 41692);   // labels.csv
+  // The lung bases in view touch the liver's dome over a few hundred voxel faces (the map leaves no
+  // diaphragm there): the 5 mm of diaphragm under them, one layer of 3 mm voxels, is about 1 % of
+  // the liver (420 voxels); more than 2 % would be the rule reaching into the organ.
+  EXPECT_GT(liver_wall, 0);
+  EXPECT_LT(liver_wall, liver / 50);
   EXPECT_GT(vertebrae, 10000);
 }
 

@@ -555,6 +555,28 @@ TEST(SceneRules, Queries) {
   EXPECT_STREQ(enum_name(RenderPreset::CtSoftTissue), "ct-soft-tissue");
 }
 
+TEST(SceneRules, TheLungsMaterialIsAeratedWallUnlabelledOrNamedLung) {
+  // The defaults: 1 kPa and ν 0.40 at or below -500 HU, for wall voxels without a label or with one the
+  // names call lung (roles.lung_ids); a labelled duodenum's gas (19), viscera, tissue above the window
+  // and everything with roles.compliant_lungs off keep their own.
+  Scene s = parse_scene(json::object(), kOrigin);
+  s.roles.lung_ids = {11, 14};
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 0, -850.0f), 1.0);
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 14, -500.0f), 1.0);
+  EXPECT_DOUBLE_EQ(s.poisson_for(Role::Wall, 11, -700.0f), 0.40);
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 14, -499.0f), 60.0);
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 19, -1000.0f), 60.0);
+  EXPECT_DOUBLE_EQ(s.poisson_for(Role::Wall, 19, -1000.0f), 0.45);
+  EXPECT_EQ(s.young_kpa_for(Role::Viscera, 0, -1000.0f), 5.5);
+  EXPECT_DOUBLE_EQ(s.poisson_for(Role::Viscera, 0, -1000.0f), 0.25);
+  s.material.label_young_kpa = {{14, 2.0, std::nullopt}};
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 14, -850.0f), 2.0);
+  EXPECT_DOUBLE_EQ(s.poisson_for(Role::Wall, 14, -850.0f), 0.45);   // its own E, its role's ν
+  s.roles.compliant_lungs = false;
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 0, -850.0f), 60.0);
+  EXPECT_DOUBLE_EQ(s.poisson_for(Role::Wall, 0, -850.0f), 0.45);
+}
+
 // ---- files -------------------------------------------------------------------------------------
 
 TEST(SceneFiles, MalformedJsonGivesLineAndColumn) {

@@ -71,6 +71,7 @@ TEST(StructureNames, TheExamplesNamesGiveTheRolesChosenByHand) {
   EXPECT_EQ(r.attached, kHandWall);   // every wall organ of the example is retroperitoneal or the bladder
   EXPECT_EQ(r.prevesical, std::vector<int>{21});
   EXPECT_EQ(r.fixed, ids_present(kHandFixed, present));
+  EXPECT_EQ(r.lung, ids_present(kHandLungs, present));
   EXPECT_TRUE(r.unknown.empty());
 }
 

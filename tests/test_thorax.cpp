@@ -181,3 +181,62 @@ TEST(Thorax, NoViscusTouchesALungOrTheHeartAndTheRuleIsWhatKeepsThemApart) {
   const std::vector<Role> without = auto_roles(r, t.g, t.hu.data(), nullptr, &t.body);
   EXPECT_GT(viscera_touching_chest(without), 100);
 }
+
+TEST(Thorax, TheLungTissueHoldsItsVesselsAndNotTheHeart) {
+  // A vessel 6 mm across (two voxels) runs through the left lung along y at x = −70, z = 130: the
+  // closing by 6 mm makes it lung tissue; the heart, the tissue under the domes and the stomach's gas
+  // are not; a labelled heart (2) stays out even where it touches the lung.
+  Trunk t = trunk();
+  int64_t vessel = 0;
+  for (int64_t v = 0; v < t.g.voxel_count(); ++v) {
+    if (t.part[std::size_t(v)] != kLung) continue;
+    const Vec3 p = t.g.to_world(Vec3(double(v % t.g.dims[0]), double((v / t.g.dims[0]) % t.g.dims[1]),
+                                     double(v / (t.g.dims[0] * t.g.dims[1]))));
+    if (std::abs(p[0] + 70.0) < 3.1 && std::abs(p[2] - 130.0) < 1.6 && std::abs(p[1]) < 40.0) {
+      t.hu[std::size_t(v)] = 40.0f;
+      ++vessel;
+    }
+  }
+  ASSERT_GT(vessel, 20);
+  const Thorax th = find_thorax(t.hu.data(), t.body, t.g);
+  int64_t vessel_in = 0;
+  for (int64_t v = 0; v < t.g.voxel_count(); ++v)
+    vessel_in += t.part[std::size_t(v)] == kLung && t.hu[std::size_t(v)] > 0.0f && th.lung_tissue[std::size_t(v)];
+  EXPECT_EQ(vessel_in, vessel);
+  EXPECT_EQ(count(t, th.lung_tissue, kLung), count(t, kLung));
+  EXPECT_LT(count(t, th.lung_tissue, kHeart), count(t, kHeart) / 20);   // the closing reaches its rim only
+  EXPECT_EQ(count(t, th.lung_tissue, kStomachGas), 0);
+  std::vector<uint8_t> labelled(t.part.size());
+  for (std::size_t v = 0; v < labelled.size(); ++v) labelled[v] = t.part[v] == kHeart ? 2 : 0;
+  const Thorax with_heart = find_thorax(t.hu.data(), t.body, t.g, &labelled);
+  EXPECT_EQ(count(t, with_heart.lung_tissue, kHeart), 0);
+  EXPECT_EQ(count(t, with_heart.lung_tissue, kLung), count(t, kLung));
+}
+
+TEST(Thorax, CompliantLungsAreWallAndFixedLungsAreFixed) {
+  // roles.compliant_lungs (the default): the lungs are wall, so the diaphragm can rise into them; the
+  // heart stays fixed. Off: the lungs are fixed, as before.
+  const Trunk t = trunk();
+  RoleRules r;
+  ASSERT_TRUE(r.compliant_lungs);
+  const std::vector<Role> compliant = auto_roles(r, t.g, t.hu.data(), nullptr, &t.body);
+  r.compliant_lungs = false;
+  const std::vector<Role> fixed = auto_roles(r, t.g, t.hu.data(), nullptr, &t.body);
+  int64_t lung = 0, lung_wall = 0, lung_fixed = 0, heart_fixed = 0, heart_inside = 0;
+  for (std::size_t v = 0; v < t.part.size(); ++v) {
+    if (t.part[v] == kLung) {
+      ++lung;
+      lung_wall += compliant[v] == Role::Wall;
+      lung_fixed += fixed[v] == Role::Fixed;
+    }
+    if (t.part[v] == kHeart && fixed[v] == Role::Fixed) {
+      ++heart_inside;
+      heart_fixed += compliant[v] == Role::Fixed;
+    }
+  }
+  EXPECT_EQ(lung_wall, lung);
+  EXPECT_EQ(lung_fixed, lung);
+  EXPECT_GT(heart_inside, 0);
+  // The heart's rim the lungs' closing reaches becomes lung tissue; the rest stays fixed.
+  EXPECT_GT(heart_fixed, heart_inside * 9 / 10);
+}

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "anatomy/anatomical_axes.h"
+#include "anatomy/distance_transform.h"
 
 namespace pneumo {
 
@@ -67,6 +68,24 @@ std::vector<double> fill_gaps(const std::vector<double>& base, int64_t n, int64_
   return out;
 }
 
+/// The morphological closing of `lung` by a ball of radius r_mm: every voxel whose r-neighbourhood
+/// lies inside the lung's r-dilation (the dilation's complement is more than r away). Fills the
+/// vessels and bronchi a lung holds; two exact distance transforms.
+std::vector<uint8_t> closing(const std::vector<uint8_t>& lung, const Geometry& g, double r_mm) {
+  const int64_t n = int64_t(lung.size());
+  std::vector<uint8_t> mask(lung.size());
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v) mask[v] = !lung[v];
+  const std::vector<float> to_lung = distance_to_outside_mm(mask, g);
+  const float r = float(r_mm);
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v) mask[v] = to_lung[v] <= r;
+  const std::vector<float> to_outside = distance_to_outside_mm(mask, g);
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v) mask[v] = lung[v] || to_outside[v] > r;
+  return mask;
+}
+
 }  // namespace
 
 Thorax find_thorax(const float* hu, const std::vector<uint8_t>& body, const Geometry& g,
@@ -82,8 +101,13 @@ Thorax find_thorax(const float* hu, const std::vector<uint8_t>& body, const Geom
     for (int64_t v = 0; v < n; ++v) aerated[v] = body[v] && hu[v] < below;
     t.lung_parts = mark_lungs_by_density(hu, aerated, g, opt, t.lungs);
   }
-  if (labelled && int64_t(labelled->size()) == n)
-    for (int64_t v = 0; v < n; ++v) t.lungs[v] |= (*labelled)[v] && body[v];
+  const bool with_labels = labelled && int64_t(labelled->size()) == n;
+  std::vector<uint8_t> lung_only = t.lungs;   // density and labelled lung, not the heart
+  if (with_labels)
+    for (int64_t v = 0; v < n; ++v) {
+      t.lungs[v] |= (*labelled)[v] && body[v];
+      lung_only[v] |= (*labelled)[v] == 1 && body[v];
+    }
 
   // The diaphragm's upper surface per column: the lowest lung voxel, as a superior index (0 = the
   // most inferior slice), -1 where the column holds no lung.
@@ -121,6 +145,10 @@ Thorax find_thorax(const float* hu, const std::vector<uint8_t>& body, const Geom
         chest += t.chest[v];
         lungs += t.lungs[v];
       }
+  t.lung_tissue = closing(lung_only, g, opt.lung_closing_mm);
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v)
+    t.lung_tissue[v] = t.lung_tissue[v] && t.chest[v] && !(with_labels && (*labelled)[v] == 2);
   const double voxel_ml = g.spacing_mm.prod() / 1000.0;
   t.chest_ml = double(chest) * voxel_ml;
   t.lung_ml = double(lungs) * voxel_ml;

@@ -1,8 +1,9 @@
 #pragma once
 // The chest above the diaphragm, found on the CT with or without labels: the lungs by their density,
 // the diaphragm as the surface under them, and what lies above it between them (the heart and the
-// mediastinum). The roles hold all of it fixed and make the first millimetres under it wall, so the
-// gas never opens beside the lungs or the heart (auto_roles.h, rules 3b and 5c).
+// mediastinum). The roles hold the heart and mediastinum fixed, make the lungs wall as soft as lung
+// (roles.compliant_lungs; fixed without it) and the first millimetres under it wall, so the gas never
+// opens beside the lungs or the heart (auto_roles.h, rules 3b and 5c).
 //
 // Lungs: 6-connected parts of aerated tissue (HU below aerated_hu) inside the body, each of at least
 // min_lung_ml whose median HU lies in [lung_median_min_hu, lung_median_max_hu]. Aerated lung is
@@ -35,17 +36,23 @@ struct ThoraxOptions {
   double lung_median_max_hu = -600.0;   // above: tissue with a few bubbles, not parenchyma
   double min_lung_ml = 15.0;            // smaller parts are bubbles or bowel gas; a lung base cut by the
                                         // scan's top slice is tens of ml
+  double lung_closing_mm = 6.0;         // the lungs' own vessels and bronchi, up to twice this across, are
+                                        // lung tissue (a morphological closing); the hilum's are wider
 };
 
 struct Thorax {
   std::vector<uint8_t> lungs;   // 1: aerated lung (by density), or a labelled lung or heart voxel
   std::vector<uint8_t> chest;   // 1: a body voxel above the diaphragm's surface (lungs included)
+  std::vector<uint8_t> lung_tissue;   // 1: the lungs with the vessels and bronchi inside them (a closing
+                                      // of the aerated and labelled lung by lung_closing_mm, within the
+                                      // chest), the labelled heart and other chest structures excluded
   double lung_ml = 0.0, chest_ml = 0.0;
   int lung_parts = 0;           // parts found by density
 };
 
 /// The thorax of the CT `hu` on grid `g` within `body` (body_mask.h). `labelled`, when not null, marks
-/// the voxels a label map names as lung or heart (structure_names.h: lies_above_the_diaphragm).
+/// the voxels a label map names as lung (1) or as another structure above the diaphragm, the heart (2)
+/// (structure_names.h: lies_above_the_diaphragm).
 Thorax find_thorax(const float* hu, const std::vector<uint8_t>& body, const Geometry& g,
                    const std::vector<uint8_t>* labelled = nullptr, const ThoraxOptions& opt = {});
 

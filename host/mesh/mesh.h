@@ -49,6 +49,9 @@ struct VoxelRoles {
 /// Young's modulus (Pa) of one voxel of tissue: its role, label (0 when none) and HU (0 without a CT).
 using VoxelYoungFn = std::function<double(Role, int label, float hu)>;
 
+/// Poisson's ratio of one voxel of tissue, from the same three (the lungs' ν by their density).
+using VoxelPoissonFn = std::function<double(Role, int label, float hu)>;
+
 /// The smallest share of a tetrahedron's volume counted as its tissue: tetrahedra of a meshed cube
 /// that hold (almost) none of their part's tissue keep this fraction of its stiffness and mass, so
 /// no node is left without stiffness or mass (the finite cell method's α). 10⁻² keeps such tetrahedra
@@ -76,6 +79,10 @@ struct MeshOptions {
   /// is the default here: a mesh built from voxels that are no CT (a test block, a validation) has no
   /// cut; scenes default to Slide (SceneMesh::cut_faces).
   CutFaces cut_faces = CutFaces::Free;
+  /// When set, each tetrahedron's ν (Mesh::tet_poisson) is the mean of its tissue's sample points'
+  /// (one tissue: its own; lung and diaphragm in one tetrahedron: between the two). Unset: the
+  /// caller fills tet_poisson.
+  VoxelPoissonFn poisson_for;
 };
 
 struct Mesh;

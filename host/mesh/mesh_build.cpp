@@ -55,6 +55,7 @@ struct CubeContent {
   int32_t tissue[kParts][5] = {{0, 0, 0, 0, 0}, {0, 0, 0, 0, 0}};
   double young_sum[kParts][5] = {{0, 0, 0, 0, 0}, {0, 0, 0, 0, 0}};
   double compliance_sum[kParts][5] = {{0, 0, 0, 0, 0}, {0, 0, 0, 0, 0}};
+  double poisson_sum[kParts][5] = {{0, 0, 0, 0, 0}, {0, 0, 0, 0, 0}};   // with MeshOptions::poisson_for
 };
 
 /// Which tetrahedron holds each sample point of a cube, for both patterns: the same in every cube, so
@@ -95,7 +96,7 @@ struct SampleTets {
 };
 
 std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& lat, const SampleTets& samples,
-                                        const VoxelYoungFn& young_pa_for) {
+                                        const VoxelYoungFn& young_pa_for, const VoxelPoissonFn& poisson_for) {
   const Geometry& g = roles.geometry;
   const CubeVoxels& L = samples.L;
   const int s3 = samples.s3;
@@ -124,13 +125,16 @@ std::vector<CubeContent> classify_cubes(const VoxelRoles& roles, const Lattice& 
                 auto hit = std::find_if(counts[p].begin(), counts[p].end(), [&](const auto& e) { return e.first == id; });
                 if (hit == counts[p].end()) counts[p].emplace_back(id, 1);
                 else ++hit->second;
-                const double young = young_pa_for(r, id, roles.hu ? roles.hu[v] : 0.0f), compliance = 1.0 / young;
+                const float hu = roles.hu ? roles.hu[v] : 0.0f;
+                const double young = young_pa_for(r, id, hu), compliance = 1.0 / young;
+                const double nu = poisson_for ? poisson_for(r, id, hu) : 0.0;
                 const uint8_t* tet =
                     tet_of[odd].data() + ((((k - c * L[2]) * L[1] + (j - b * L[1])) * L[0] + (i - a * L[0])) * s3);
                 for (int m = 0; m < s3; ++m) {
                   ++cc.tissue[p][tet[m]];
                   cc.young_sum[p][tet[m]] += young;
                   cc.compliance_sum[p][tet[m]] += compliance;
+                  cc.poisson_sum[p][tet[m]] += nu;
                 }
               }
           // The most frequent label; on a tie the lowest id.
@@ -626,7 +630,7 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
   require_mesh_memory(roles, opt);
 
   const SampleTets samples(L);
-  const std::vector<CubeContent> content = classify_cubes(roles, lat, samples, young_pa_for);
+  const std::vector<CubeContent> content = classify_cubes(roles, lat, samples, young_pa_for, opt.poisson_for);
   const std::array<int64_t, 5> tet_samples[2] = {samples.per_tet(0), samples.per_tet(1)};
   const bool with_viscera = opt.model == MeshModel::WallViscera;
 
@@ -690,6 +694,9 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
             m.tet_young_pa.push_back(std::max(
                 double(tissue) / total * hill_modulus(content[q].young_sum[p][k], content[q].compliance_sum[p][k], tissue),
                 floor_young));
+            if (opt.poisson_for)
+              m.tet_poisson.push_back(tissue > 0 ? content[q].poisson_sum[p][k] / double(tissue)
+                                                 : opt.poisson_for(role, label, 0.0f));
           }
         }
       }

@@ -60,11 +60,9 @@ Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene, bool to_solve
     opt.reserve_bytes_per_node = solver.per_node;
     opt.reserve_bytes_per_tet = solver.per_tet;
   }
+  opt.poisson_for = [&](Role r, int label, float hu) { return scene.poisson_for(r, label, hu); };
   Mesh m = build_mesh(roles, opt,
                       VoxelYoungFn([&](Role r, int label, float hu) { return scene.young_kpa_for(r, label, hu) * 1e3; }));
-  m.tet_poisson.resize(m.tets.size());
-  for (std::size_t t = 0; t < m.tets.size(); ++t)
-    m.tet_poisson[t] = scene.poisson_for(m.tet_part[t] == Part::Wall ? Role::Wall : Role::Viscera, m.tet_label[t]);
   MaterialOptions mat;
   mat.density_kg_m3 = scene.material.density_kg_m3;
   mat.damping_ratio = scene.material.damping_ratio;

@@ -65,9 +65,13 @@ std::vector<Role> decide_by_labels_and_hu(const RoleRules& r, const std::vector<
 
 /// Rule 3b: the chest above the diaphragm (anatomy/thorax.h): its lungs, and what lies deeper than
 /// the wall's shell (the heart, the mediastinum), fixed; the chest wall is left to the shell rule, as
-/// where the lungs and heart are labelled. Returns what is held (labelled lungs and heart included):
-/// rule 5c's diaphragm lies under it.
-std::vector<uint8_t> fix_the_chest(std::vector<Role>& role, const RoleRules& r, const Geometry& g, const float* hu,
+/// where the lungs and heart are labelled. Returns what is held (labelled lungs and heart included,
+/// rule 5c's diaphragm lies under it) and the lungs and heart alone.
+struct Chest {
+  std::vector<uint8_t> held, lungs;
+};
+
+Chest fix_the_chest(std::vector<Role>& role, const RoleRules& r, const Geometry& g, const float* hu,
                                    const uint16_t* label, const std::vector<uint8_t>& body,
                                    const std::vector<float>& depth_mm) {
   const int64_t n = int64_t(role.size());
@@ -77,7 +81,7 @@ std::vector<uint8_t> fix_the_chest(std::vector<Role>& role, const RoleRules& r, 
     bool any = false;
     for (const auto& [id, name] : r.label_names)
       if (id > 0 && id < 65536 && lies_above_the_diaphragm(name)) {
-        chest_id[std::size_t(id)] = 1;
+        chest_id[std::size_t(id)] = compartment_of(name) == Compartment::Lung ? 1 : 2;
         any = true;
       }
     if (any) {
@@ -89,40 +93,54 @@ std::vector<uint8_t> fix_the_chest(std::vector<Role>& role, const RoleRules& r, 
   const Thorax t = find_thorax(hu, body, g, labelled.empty() ? nullptr : &labelled);
   std::vector<uint8_t> held(static_cast<std::size_t>(n));
   const float shell = float(r.auto_wall_thickness_mm);
-  int64_t count = 0;
-#pragma omp parallel for schedule(static) reduction(+ : count)
+  int64_t count = 0, lung = 0;
+#pragma omp parallel for schedule(static) reduction(+ : count, lung)
   for (int64_t v = 0; v < n; ++v) {
     held[v] = t.lungs[v] || (t.chest[v] && depth_mm[v] > shell);
-    if (held[v] && role[v] == kUndecided) role[v] = Role::Fixed;
-    count += held[v];
+    if (held[v] && role[v] == kUndecided)   // the lungs and their vessels compliant: the diaphragm rises into them
+      role[v] = r.compliant_lungs && t.lung_tissue[v] ? Role::Wall : Role::Fixed;
+    lung += t.lung_tissue[v] && role[v] == Role::Wall;   // found here or labelled lung by name
+    count += held[v] && role[v] == Role::Fixed;
   }
   if (t.lung_ml > 0.0) {
     char line[256];
     std::snprintf(line, sizeof line,
-                  "roles: the chest above the diaphragm: lungs %.0f ml (%d part%s by density%s), %.0f ml held fixed, "
-                  "the diaphragm under it wall",
+                  "roles: the chest above the diaphragm: lungs %.0f ml (%d part%s by density%s), %.0f ml of lung "
+                  "wall (compliant), %.0f ml held fixed, the diaphragm under it wall",
                   t.lung_ml, t.lung_parts, t.lung_parts == 1 ? "" : "s", labelled.empty() ? "" : ", and the labelled lungs and heart",
-                  double(count) * g.spacing_mm.prod() / 1000.0);
+                  double(lung) * g.spacing_mm.prod() / 1000.0, double(count) * g.spacing_mm.prod() / 1000.0);
     log::info(line);
   } else {
     log::debug("roles: no lung in view: no chest above the diaphragm to hold");
   }
-  return held;
+  return {std::move(held), t.lungs};
 }
 
 /// Rule 5c: undecided voxels within auto_diaphragm_thickness_mm of the held chest → wall (the diaphragm).
-void wall_under_the_chest(std::vector<Role>& role, const std::vector<uint8_t>& held, const Geometry& g,
-                          const RoleRules& r) {
-  if (!(r.auto_diaphragm_thickness_mm > 0.0) || std::none_of(held.begin(), held.end(), [](uint8_t h) { return h; })) return;
+/// With compliant lungs, labelled viscera within that distance of a lung or the heart too: a label
+/// map that leaves no diaphragm between the lung base and the liver (3 mm voxels often do) would
+/// otherwise let the gas open against the lung, which now moves.
+void wall_under_the_chest(std::vector<Role>& role, const Chest& chest, const Geometry& g, const RoleRules& r) {
+  const auto any = [](const std::vector<uint8_t>& m) { return std::any_of(m.begin(), m.end(), [](uint8_t h) { return h; }); };
+  if (!(r.auto_diaphragm_thickness_mm > 0.0) || !any(chest.held)) return;
   const int64_t n = int64_t(role.size());
+  const float thickness = float(r.auto_diaphragm_thickness_mm);
   std::vector<uint8_t> away(static_cast<std::size_t>(n));
 #pragma omp parallel for schedule(static)
-  for (int64_t v = 0; v < n; ++v) away[v] = !held[v];
-  const std::vector<float> to_chest_mm = distance_to_outside_mm(away, g);
-  const float thickness = float(r.auto_diaphragm_thickness_mm);
+  for (int64_t v = 0; v < n; ++v) away[v] = !chest.held[v];
+  {
+    const std::vector<float> to_chest_mm = distance_to_outside_mm(away, g);
+#pragma omp parallel for schedule(static)
+    for (int64_t v = 0; v < n; ++v)
+      if (role[v] == kUndecided && to_chest_mm[v] <= thickness) role[v] = Role::Wall;
+  }
+  if (!r.compliant_lungs || !any(chest.lungs)) return;
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < n; ++v) away[v] = !chest.lungs[v];
+  const std::vector<float> to_lungs_mm = distance_to_outside_mm(away, g);
 #pragma omp parallel for schedule(static)
   for (int64_t v = 0; v < n; ++v)
-    if (role[v] == kUndecided && to_chest_mm[v] <= thickness) role[v] = Role::Wall;
+    if (role[v] == Role::Viscera && to_lungs_mm[v] <= thickness) role[v] = Role::Wall;
 }
 
 /// Rule 4: undecided body voxels behind the spine's front → fixed.
@@ -269,7 +287,7 @@ std::vector<Role> auto_roles(const RoleRules& r, const Geometry& g, const float*
   const std::vector<float> depth_mm = distance_to_outside_mm(body, g);
   timer.done(2, "labels and bone");
 
-  std::vector<uint8_t> chest;
+  Chest chest;
   if (r.auto_thorax) chest = fix_the_chest(role, r, g, hu, label, body, depth_mm);
   timer.done(3, "chest");
 

@@ -8,7 +8,8 @@
 //   3. HU > auto_bone_threshold_hu → fixed (bone);
 //   3b. with auto_thorax: the chest above the diaphragm (anatomy/thorax.h: the lungs by density or
 //      by their labels, the diaphragm's surface under them, the heart and mediastinum between them):
-//      the lungs, and the rest of it deeper than auto_wall_thickness_mm, → fixed;
+//      the rest of it deeper than auto_wall_thickness_mm → fixed; the lungs with their vessels
+//      (Thorax::lung_tissue) → wall with compliant_lungs (the diaphragm rises into them), else fixed;
 //   4. the back: behind the anterior surface of the vertebral column in the slice → fixed
 //      (back_region.h; the column is found from rules 1 and 3's fixed voxels near the midline);
 //   5. the shell: within auto_wall_thickness_mm of the body's surface (3-D Euclidean distance in mm,
@@ -22,7 +23,8 @@
 //      peritoneum lies in front of the bladder at that level, and the tissue behind the organ is on
 //      its peritoneal side;
 //   5c. with auto_thorax: undecided tissue within auto_diaphragm_thickness_mm of 3b's chest → wall:
-//      the diaphragm, so the gas opens under it, never beside a lung or the heart;
+//      the diaphragm, so the gas opens under it, never beside a lung or the heart; with
+//      compliant_lungs, labelled viscera within that distance of a lung or the heart too;
 //   6. deeper tissue lateral to bone that is at least 40 mm from the midline (hip joints, iliac
 //      wings, pubic rami: the gluteal, hip and thigh muscles) → fixed (lateral_to_bone.h);
 //   6b. with auto_use_labels and a label map: in the axial slices from the top (dome) of the

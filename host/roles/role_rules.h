@@ -22,10 +22,19 @@ struct RoleRules {
   double auto_bone_threshold_hu = 250.0;   // above soft tissue and enhanced vessels in most scans
   double auto_wall_thickness_mm = 30.0;    // skin + fat + muscle of an adult abdomen
   double auto_wall_max_angle_deg = 100.0;  // anterior (0) and lateral (90) sides; the back is not
-  // The chest above the diaphragm found on the CT (anatomy/thorax.h) and held fixed, the first
-  // auto_diaphragm_thickness_mm under it made wall: no gas opens beside the lungs or the heart.
+  // The chest above the diaphragm found on the CT (anatomy/thorax.h) and held fixed but for the lungs
+  // (compliant_lungs), the first auto_diaphragm_thickness_mm under it made wall: no gas opens beside
+  // the lungs or the heart.
   bool auto_thorax = true;
   double auto_diaphragm_thickness_mm = 5.0;
+  // The lungs are wall tissue of the lung's stiffness (SceneMaterial::lung_young_kpa), not fixed, so
+  // the diaphragm rises into the chest as the abdomen fills: labelled lungs (by name) and the lungs
+  // the CT's density finds, their vessels within (anatomy/thorax.h). The heart, the mediastinum and
+  // the ribs stay fixed.
+  bool compliant_lungs = true;
+  // The ids the label names call lung (filled by the scene, not a key): their aerated voxels, and
+  // unlabelled ones, take the lungs' material; a labelled duodenum's or rectum's gas does not.
+  std::vector<int> lung_ids;
   bool auto_use_labels = true;
   // Ids the lists do not name take the role their structure's name gives (roles/structure_names.h).
   bool by_name = true;

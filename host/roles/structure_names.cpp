@@ -59,12 +59,14 @@ const std::vector<NameRule>& rules() {
          "renal_(artery|arteries|vein|veins)|common_iliac_(artery|vein)|iliac_(artery|arteries|vena|vein|veins)|"
          "ureters?|rectum",
          Compartment::Retroperitoneal},
+        // The lungs: the room the diaphragm rises into (roles.compliant_lungs).
+        {"lungs?(_.*)?", Compartment::Lung},
         // What does not move: bone and cartilage, the back's and hip's muscles, the thorax, the head,
         // the neck's vessels, the pelvic organs below the peritoneum.
         {"vertebra(e)?(_.*)?|spine|ribs?|sacrum|coccyx|hips?|pelvis|(head_of_)?femur.*|humerus|scapula|"
          "clavicul(a|e)|sternum|costal_cartilages?|skull|mandible|spinal_(cord|canal)|"
          "gluteus_(maximus|medius|minimus)|autochthon|iliopsoas|psoas(_major)?|iliacus|quadratus_lumborum|"
-         "erector_spinae|lungs?(_.*)?|heart(_.*)?|myocardium|atrial_appendage|pulmonary_(artery|vein|trunk)|"
+         "erector_spinae|heart(_.*)?|myocardium|atrial_appendage|pulmonary_(artery|vein|trunk)|"
          "trachea|o?esophagus|thyroid(_gland)?|brachiocephalic_(trunk|vein)|subclavian_artery|"
          "common_carotid_artery|superior_vena_cava|mediastinum|thymus|brain|face|prostate.*|uterus|"
          "seminal_vesicles?",
@@ -85,6 +87,7 @@ const char* compartment_name(Compartment c) {
     case Compartment::Retroperitoneal: return "retroperitoneal";
     case Compartment::Prevesical: return "prevesical";
     case Compartment::AbdominalWall: return "abdominal wall";
+    case Compartment::Lung: return "lung";
     case Compartment::Fixed: return "fixed";
     case Compartment::Tissue: return "tissue";
     case Compartment::Unknown: return "unknown";
@@ -121,6 +124,7 @@ RolesFromNames roles_from_names(const std::map<int, std::string>& names, const s
         r.attached.push_back(id);
         break;
       case Compartment::AbdominalWall: r.wall.push_back(id); break;
+      case Compartment::Lung: r.lung.push_back(id); break;
       case Compartment::Fixed: r.fixed.push_back(id); break;
       case Compartment::Tissue: r.tissue.push_back(id); break;
       case Compartment::Unknown: r.unknown.push_back(id); break;

@@ -13,7 +13,9 @@
 //   prevesical       the bladder: retroperitoneal, and the space in front of it is extraperitoneal
 //                    (roles.auto_prevesical_labels: no gas opens in front of it);
 //   abdominal wall   the wall's own muscles (rectus, obliques, transversus) and the diaphragm: wall;
-//   fixed            bone, the back's and the hip's muscles, the thorax's contents (lungs, heart,
+//   lung             the lungs and their lobes: wall of the lung's stiffness with roles.compliant_lungs
+//                    (the diaphragm rises into them), else fixed;
+//   fixed            bone, the back's and the hip's muscles, the thorax's other contents (heart,
 //                    mediastinal vessels), the head, the pelvic organs below the peritoneum: fixed;
 //   tissue           a tissue class without a place (fat, muscle, skin, body): left to the HU rules;
 //   unknown          a name the table does not know: left to the HU rules, and a warning names it.
@@ -23,7 +25,7 @@
 
 namespace pneumo {
 
-enum class Compartment { Peritoneal, Retroperitoneal, Prevesical, AbdominalWall, Fixed, Tissue, Unknown };
+enum class Compartment { Peritoneal, Retroperitoneal, Prevesical, AbdominalWall, Lung, Fixed, Tissue, Unknown };
 
 /// "peritoneal", "retroperitoneal", …
 const char* compartment_name(Compartment c);
@@ -41,6 +43,7 @@ bool lies_above_the_diaphragm(const std::string& name);
 /// and the names the table does not know.
 struct RolesFromNames {
   std::vector<int> wall, viscera, fixed, attached, prevesical;
+  std::vector<int> lung;      // ids of the lungs: wall or fixed as roles.compliant_lungs says
   std::vector<int> unknown;   // ids whose name the table does not know (HU rules decide them)
   std::vector<int> tissue;    // ids of tissue classes (HU rules decide them, no warning)
 };

@@ -61,6 +61,14 @@ struct SceneMaterial {
   // window of CT body-composition studies) take fat_young_kpa unless their label has its own value.
   std::optional<double> fat_young_kpa = 3.0;   // the upper end of 1-3 kPa for fat; null = off
   double fat_hu_min = -190.0, fat_hu_max = -30.0;
+  // The lungs, where roles.compliant_lungs makes them wall (the thorax the diaphragm rises into): wall
+  // voxels at or below lung_hu_max (aerated lung), unlabelled or labelled lung, take lung_young_kpa and
+  // lung_poisson_ratio unless their label has its own E. 1.0 kPa and 0.40 give the parenchyma's bulk modulus 1.7 kPa (a 2 L
+  // anaesthetised lung of compliance 0.12 L/cmH2O) and shear modulus 0.36 kPa (0.7 × a 5 cmH2O
+  // transpulmonary pressure, Lai-Fook 1977): docs/fidelity.md, "The diaphragm".
+  std::optional<double> lung_young_kpa = 1.0;   // null = off (the wall's E)
+  double lung_poisson_ratio = 0.40;
+  double lung_hu_max = -500.0;   // the body's own threshold: the skin's partial-volume rim is never lung
   double damping_ratio = 0.4;     // ζ, Nimura (§4)
   double spring_scale = 1.0;      // as published; 0.925 matches the lattice to E (§4)
   SpringModel spring_model = SpringModel::Nonlinear;  // rotation-invariant (§5)
@@ -174,6 +182,11 @@ struct Scene {
   double young_kpa_for(Role role, int label, float hu) const;
   /// ν of the finite elements for a role and label.
   double poisson_for(Role role, int label) const;
+  /// The same for one voxel of HU `hu`: lung_poisson_ratio for aerated wall voxels.
+  double poisson_for(Role role, int label, float hu) const;
+  /// Whether a voxel of this role, label and HU is lung tissue of the wall: aerated wall, unlabelled
+  /// or of a label named lung (roles.lung_ids), with roles.compliant_lungs and lung_young_kpa set.
+  bool is_lung_voxel(Role role, int label, float hu) const;
 
   /// Kitasaka's k_v (kPa): volume_stiffness_kpa when set; unset: young_kpa for kitasaka2004
   /// (the 2004 scheme needs it: its springs alone let tetrahedra collapse), 0 for the others.

@@ -122,11 +122,16 @@ const Table<RoleRules>& roles_table() {
        "the rest of the shell (the back, on the table) is fixed, the body inside it viscera."},
       {"auto_thorax", &RoleRules::auto_thorax, "", any(),
        "auto: find the chest above the diaphragm (anatomy/thorax.h: the lungs by density or by their labels, the "
-       "diaphragm as the surface under them, the heart and mediastinum between them) and hold it fixed, so no gas "
+       "diaphragm as the surface under them, the heart and mediastinum between them), hold the heart and "
+       "mediastinum fixed and the lungs too unless compliant_lungs, with a diaphragm of wall under it, so no gas "
        "opens beside the lungs or the heart (docs/roles.md)."},
       {"auto_diaphragm_thickness_mm", &RoleRules::auto_diaphragm_thickness_mm, "mm", in(0, 50),
        "auto with auto_thorax: undecided tissue within this distance under the chest is wall (the diaphragm, a "
        "muscle sheet of a few mm; 5 keeps a voxel of wall between lung and gas on 3 mm grids). 0: none."},
+      {"compliant_lungs", &RoleRules::compliant_lungs, "", any(),
+       "The lungs (labelled by name, or found by density with auto_thorax) are wall tissue as soft as lung "
+       "(material.lung_young_kpa), so the diaphragm rises into the chest under the gas; the heart, mediastinum and "
+       "ribs stay fixed. false: the lungs are fixed and the diaphragm cannot rise (docs/fidelity.md, the diaphragm)."},
       {"auto_use_labels", &RoleRules::auto_use_labels, "", any(),
        "auto with a label map: voxels whose label is in a role list keep that role; HU rules fill in the rest."},
       {"by_name", &RoleRules::by_name, "", any(),
@@ -214,6 +219,16 @@ const Table<SceneMaterial>& material_table() {
        "null = off (their role's E). Default 3, the upper end of 1-3 kPa for fat (docs/fidelity.md §3)."},
       {"fat_hu_min", &SceneMaterial::fat_hu_min, "HU", in(-1024, 3071), "Lower end of the fat window (-190)."},
       {"fat_hu_max", &SceneMaterial::fat_hu_max, "HU", in(-1024, 3071), "Upper end of the fat window (-30)."},
+      {"lung_young_kpa", &SceneMaterial::lung_young_kpa, "kPa", in(kMinKPa, kMaxKPa),
+       "With roles.compliant_lungs: E of aerated wall voxels (HU at or below lung_hu_max: the lungs), "
+       "unlabelled or of a label named lung, unless their label has an E of its own; null = off (the wall's E). Default 1.0 with lung_poisson_ratio 0.40: bulk modulus "
+       "1.7 kPa, the anaesthetised lung's volume over its compliance, shear 0.36 kPa (Lai-Fook 1977; "
+       "docs/fidelity.md, the diaphragm)."},
+      {"lung_poisson_ratio", &SceneMaterial::lung_poisson_ratio, "", in(0, 0.49),
+       "ν of the lungs' finite elements (0.40; the springs ignore it)."},
+      {"lung_hu_max", &SceneMaterial::lung_hu_max, "HU", in(-1024, 3071),
+       "With compliant_lungs, wall voxels at or below this are lung (-500, the body mask's threshold: aerated lung "
+       "lies below at any inspiration, and the skin's partial-volume rim, body only above it, is never lung)."},
       {"damping_ratio", &SceneMaterial::damping_ratio, "", in(0, 10),
        "ζ: each spring's damper c = 2ζ√(m k) (§4; Nimura 0.4)."},
       {"spring_scale", &SceneMaterial::spring_scale, "", in(0.01, 10),

@@ -1,5 +1,7 @@
 // Answers later stages ask of a scene, so that each rule (label → role, label → E, the default
 // k_v) is written once rather than in every consumer.
+#include <algorithm>
+
 #include "core/error.h"
 #include "scene/scene.h"
 
@@ -23,8 +25,15 @@ double Scene::young_kpa_for(Role role, int label) const {
 double Scene::young_kpa_for(Role role, int label, float hu) const {
   for (const LabelYoung& l : material.label_young_kpa)
     if (l.label == label) return l.young_kpa;
+  if (is_lung_voxel(role, label, hu)) return *material.lung_young_kpa;
   if (material.fat_young_kpa && hu >= material.fat_hu_min && hu <= material.fat_hu_max) return *material.fat_young_kpa;
   return young_kpa_for(role, label);
+}
+
+bool Scene::is_lung_voxel(Role role, int label, float hu) const {
+  if (role != Role::Wall || !roles.compliant_lungs || !material.lung_young_kpa || hu > material.lung_hu_max)
+    return false;
+  return label == 0 || std::find(roles.lung_ids.begin(), roles.lung_ids.end(), label) != roles.lung_ids.end();
 }
 
 double Scene::poisson_for(Role role, int label) const {
@@ -35,10 +44,18 @@ double Scene::poisson_for(Role role, int label) const {
   return material.poisson_ratio;
 }
 
+double Scene::poisson_for(Role role, int label, float hu) const {
+  for (const LabelYoung& l : material.label_young_kpa)
+    if (l.label == label) return l.poisson_ratio ? *l.poisson_ratio : poisson_for(role, label);
+  if (is_lung_voxel(role, label, hu)) return material.lung_poisson_ratio;
+  return poisson_for(role, label);
+}
+
 void use_nimura_springs(SceneMaterial& m) {
   m.model = MaterialModel::Msd;
   m.stiffening = 0.0;
   m.fat_young_kpa.reset();
+  m.lung_young_kpa.reset();
   m.viscera_young_kpa.reset();
 }
 

@@ -61,6 +61,9 @@ void assign_roles_by_name(Scene& s, const nlohmann::json& given) {
   const std::string& names_file = s.inputs.label_names.empty() ? s.inputs.labels : s.inputs.label_names;
   if (!exists(names_file)) return;
   r.label_names = scene_label_names(s);   // the messages name structures in every mode
+  r.lung_ids.clear();                     // the lungs' material goes by name in every mode too
+  for (const auto& [id, name] : r.label_names)
+    if (id > 0 && compartment_of(name) == Compartment::Lung) r.lung_ids.push_back(id);
   if (r.source != RoleSource::Auto || !r.by_name || !r.auto_use_labels) return;
   const bool scene_lists = !r.wall_labels.empty() || !r.viscera_labels.empty() || !r.fixed_labels.empty();
   if (r.label_names.empty() && !scene_lists) {
@@ -77,7 +80,9 @@ void assign_roles_by_name(Scene& s, const nlohmann::json& given) {
   append_sorted(r.wall_labels, by_name.wall);
   append_sorted(r.viscera_labels, by_name.viscera);
   append_sorted(r.fixed_labels, by_name.fixed);
-  for (const auto* l : {&by_name.wall, &by_name.viscera, &by_name.fixed}) append_sorted(r.ids_from_names, *l);
+  append_sorted(r.compliant_lungs ? r.wall_labels : r.fixed_labels, by_name.lung);
+  for (const auto* l : {&by_name.wall, &by_name.viscera, &by_name.fixed, &by_name.lung})
+    append_sorted(r.ids_from_names, *l);
   if (!has_key(given, "roles", "auto_prevesical_labels")) append_sorted(r.auto_prevesical_labels, by_name.prevesical);
   if (!has_key(given, "mesh", "attached_labels") && !by_name.attached.empty()) {
     if (solves_force_fields(s.solver.method)) append_sorted(s.mesh.attached_labels, by_name.attached);
@@ -86,7 +91,10 @@ void assign_roles_by_name(Scene& s, const nlohmann::json& given) {
                 "\" cannot bond the viscera to the retroperitoneal organs (mesh.attached_labels): their interface may open");
   }
   log::info("roles by name: viscera " + named_ids(by_name.viscera, r.label_names) + "; wall " +
-            named_ids(by_name.wall, r.label_names) + "; fixed " + named_ids(by_name.fixed, r.label_names, 6));
+            named_ids(by_name.wall, r.label_names) + "; fixed " + named_ids(by_name.fixed, r.label_names, 6) +
+            (by_name.lung.empty() ? std::string()
+                                  : std::string("; lungs (") + (r.compliant_lungs ? "wall, compliant" : "fixed") +
+                                        ") " + named_ids(by_name.lung, r.label_names, 6)));
   if (!by_name.unknown.empty())
     log::warn("roles: no role is known for the names of " + named_ids(by_name.unknown, r.label_names) +
               ": the CT's HU rules decide their voxels; list their ids in roles.wall_labels, viscera_labels or "
