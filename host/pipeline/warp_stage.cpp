@@ -19,6 +19,8 @@
 #include "anatomy/body_mask.h"
 #include "pipeline/cavity_measures.h"
 #include "pipeline/organ_motion.h"
+#include "anatomy/thorax.h"
+#include "pipeline/diaphragm_motion.h"
 #include "pipeline/skin_area.h"
 #include "pipeline/scene_stages.h"
 #include "render/render_volume.h"
@@ -386,14 +388,22 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
   if (!w.roles.role.empty() && w.roles.hu()) {
     const PointMap& to_deformed = point_map();
     const std::vector<uint8_t> body = body_mask(w.roles.hu(), w.roles.geometry, scene.roles.auto_body_threshold_hu);
-    const SkinArea skin = wall_skin_area(voxel_roles_of(w.roles), body, [&to_deformed](const Vec3& rest, Vec3& moved) {
+    const CarryFn carry = [&to_deformed](const Vec3& rest, Vec3& moved) {
       const MappedPoint p = to_deformed.to_deformed(rest);
       moved = p.point_mm;
       return p.carried;
-    });
+    };
+    const SkinArea skin = wall_skin_area(voxel_roles_of(w.roles), body, carry);
     if (skin.faces > 0) {
       j["wall_skin_area_cm2"] = skin.rest_mm2 / 100.0;
       j["wall_skin_area_change_fraction"] = skin.change();
+    }
+    // The diaphragm's rise into the chest (pipeline/diaphragm_motion.h), where a lung base is in view.
+    const Thorax thorax = find_thorax(w.roles.hu(), body, w.roles.geometry);
+    const DiaphragmMotion diaphragm = diaphragm_motion(voxel_roles_of(w.roles), body, thorax.lungs, carry);
+    if (diaphragm.columns > diaphragm.not_carried) {
+      j["diaphragm_cranial_shift_mm"] = diaphragm.median_cranial_mm;
+      j["diaphragm_dome_cranial_shift_mm"] = diaphragm.dome_cranial_mm;
     }
   }
   j["warp"] = {{"device", w.result.device},

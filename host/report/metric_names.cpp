@@ -32,6 +32,8 @@ constexpr Entry kEntries[] = {
     {"viscera_volume_change_ml", "Change of the viscera's tissue volume", "ml", "Result", 1},
     {"wall_skin_area_cm2", "The wall's skin at rest (anterior and lateral)", "cm²", "Result", 1},
     {"wall_skin_area_change_fraction", "Growth of the wall's skin (patients: +15 %, Song 2006)", "%", "Result", 100},
+    {"diaphragm_cranial_shift_mm", "The diaphragm's cranial shift, median over the lung bases in view", "mm", "Result", 1},
+    {"diaphragm_dome_cranial_shift_mm", "The diaphragm's cranial shift where it rose most (95th percentile)", "mm", "Result", 1},
     {"organ_motion.label", "Label", "", "Result", 1},
     {"organ_motion.name", "Structure", "", "Result", 1},
     {"organ_motion.volume_ml", "Volume at rest", "ml", "Result", 1},
