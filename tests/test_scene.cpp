@@ -500,6 +500,12 @@ TEST(SceneRules, FiniteElementsNeedAStaticSolverAndRefuseTheSpringsOwnKeys) {
   // Each rule of check_material_model, with the message a user reads.
   // The co-rotational law is linear: chosen without a stiffening of its own, it takes 0, not the default's b.
   EXPECT_EQ(parse_scene({{"material", {{"model", "fem-corotational"}}}}, kOrigin).material.stiffening, 0.0);
+  // The linear law gets no 3 kPa fat unless the scene asks for it (scene_parse.cpp, model_patch).
+  EXPECT_FALSE(parse_scene({{"material", {{"model", "fem-corotational"}}}}, kOrigin).material.fat_young_kpa);
+  EXPECT_EQ(parse_scene({{"material", {{"model", "fem-corotational"}, {"fat_young_kpa", 3}}}}, kOrigin)
+                .material.fat_young_kpa,
+            3.0);
+  EXPECT_EQ(parse_scene(json::object(), kOrigin).material.fat_young_kpa, 3.0);
   EXPECT_EQ(parse_scene({{"material", {{"model", "fem-neohookean"}}}}, kOrigin).material.stiffening, 10.0);
   EXPECT_NO_THROW(parse_scene({{"material", {{"model", "fem-corotational"}}}, {"solver", {{"method", "static"}}}},
                               kOrigin));

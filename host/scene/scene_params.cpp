@@ -216,7 +216,8 @@ const Table<SceneMaterial>& material_table() {
        "E per label id, over the role's value: [{\"label\": 5, \"young_kpa\": 3}]."},
       {"fat_young_kpa", &SceneMaterial::fat_young_kpa, "kPa", in(kMinKPa, kMaxKPa),
        "E of wall and viscera voxels in the fat window [fat_hu_min, fat_hu_max] unless their label has one; "
-       "null = off (their role's E). Default 3, the upper end of 1-3 kPa for fat (docs/fidelity.md §3)."},
+       "null = off (their role's E). Default 3, the upper end of 1-3 kPa for fat (docs/fidelity.md §3); null with "
+       "fem-corotational, a linear law that 12 mmHg would turn such tissue inside out in."},
       {"fat_hu_min", &SceneMaterial::fat_hu_min, "HU", in(-1024, 3071), "Lower end of the fat window (-190)."},
       {"fat_hu_max", &SceneMaterial::fat_hu_max, "HU", in(-1024, 3071), "Upper end of the fat window (-30)."},
       {"lung_young_kpa", &SceneMaterial::lung_young_kpa, "kPa", in(kMinKPa, kMaxKPa),

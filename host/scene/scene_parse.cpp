@@ -181,9 +181,13 @@ void fill_absent(nlohmann::json& scene, const nlohmann::json& defaults) {
 }
 
 /// The defaults a model changes: the co-rotational law is linear and has no stiffening, so the default's b
-/// (Demiray's) becomes 0 for it; a stiffening the scene gives is refused by validate_scene.
+/// (Demiray's) becomes 0 for it; a stiffening the scene gives is refused by validate_scene. Nor does it
+/// get the default's fat at 3 kPa: 12 mmHg (1.6 kPa) strains such tissue past 50 %, where a linear law
+/// lets a tetrahedron turn inside out at lower energy and Newton finds no step that keeps them all
+/// (on the real CT: "no descent"); its fat takes the wall's E unless the scene gives fat_young_kpa.
 nlohmann::json model_patch(MaterialModel model) {
-  if (model == MaterialModel::FemCorotational) return {{"material", {{"stiffening", 0.0}}}};
+  if (model == MaterialModel::FemCorotational)
+    return {{"material", {{"stiffening", 0.0}, {"fat_young_kpa", nullptr}}}};
   return nlohmann::json::object();
 }
 
