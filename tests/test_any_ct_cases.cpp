@@ -25,12 +25,12 @@
 #include <set>
 #include <vector>
 
-#include "cli_test_support.h"
 #include "crop_test_support.h"
 #include "example_roles_support.h"
 #include "io/label_table.h"
 #include "io/volume_io.h"
 #include "io_test_support.h"
+#include "scene_run_support.h"
 
 using namespace pneumo;
 using namespace pneumo::testing_support;
@@ -76,14 +76,13 @@ Outcome run_case(const ScratchDir& dir, const std::string& name, const Volume& c
     scene["inputs"]["label_names"] = totalseg_dir() + "/labels.csv";
   }
   if (!by_name) scene["roles"] = {{"by_name", false}, {"auto_use_labels", false}};
-  const std::string scene_path = dir.file(name + ".json"), out = dir.file(name);
-  std::ofstream(scene_path) << scene.dump(2);
-  const CliResult r = run_pneumo("-q run " + scene_path + " --out " + out);
+  const SceneRun r = run_scene(dir, name, scene);
   Outcome o;
   o.code = r.code;
   o.err = r.err;
   if (r.code != 0) return o;
-  const nlohmann::json metrics = nlohmann::json::parse(slurp(out + "/metrics.json"));
+  const std::string& out = r.out;
+  const nlohmann::json& metrics = r.metrics;
   o.rise_mm = metrics["anterior_rise_mm"].get<double>();
   o.cavity_ml = metrics["cavity_volume_ml"].get<double>();
 

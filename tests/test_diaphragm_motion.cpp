@@ -8,13 +8,11 @@
 #include <cmath>
 #include <vector>
 
-#include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "cli_test_support.h"
 #include "io/volume_io.h"
-#include "io_test_support.h"
 #include "pipeline/diaphragm_motion.h"
+#include "scene_run_support.h"
 
 using namespace pneumo;
 using namespace pneumo::testing_support;
@@ -111,14 +109,13 @@ PhantomRun run_phantom(const ScratchDir& dir, const std::string& name, const nlo
   scene["inputs"] = {{"ct", dir.file("ph/ct.nii.gz")}, {"labels", dir.file("ph/labels.nii.gz")},
                      {"label_names", dir.file("ph/label_names.csv")}};
   if (!roles.empty()) scene["roles"] = roles;
-  const std::string scene_path = dir.file(name + ".json"), out = dir.file(name);
-  std::ofstream(scene_path) << scene.dump(2);
-  const CliResult r = run_pneumo("-q run " + scene_path + " --out " + out);
+  const SceneRun r = run_scene(dir, name, scene);
   PhantomRun p;
   p.code = r.code;
   p.err = r.err;
   if (r.code != 0) return p;
-  p.metrics = nlohmann::json::parse(slurp(out + "/metrics.json"));
+  p.metrics = r.metrics;
+  const std::string out = r.out;
   // Gas 6-adjacent to the lungs (11, 14) or the heart (51) in the deformed labels.
   const Volume lab = read_volume(out + "/deformed_labels.nii.gz");
   const int gas = p.metrics["warp"]["cavity_label"].get<int>();

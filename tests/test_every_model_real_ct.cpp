@@ -5,40 +5,20 @@
 // window out, and a scene that asks for it gets that failure with the parameters to change.
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <nlohmann/json.hpp>
-
-#include "cli_test_support.h"
 #include "example_roles_support.h"
-#include "io_test_support.h"
+#include "scene_run_support.h"
 
 using namespace pneumo::testing_support;
-
-namespace {
-
-nlohmann::json run_model(const ScratchDir& dir, const std::string& name, const nlohmann::json& material, int& code,
-                         std::string& err) {
-  nlohmann::json scene = {{"name", name}, {"load", {{"pressure_mmhg", 12}}}, {"material", material}};
-  scene["inputs"] = {{"ct", example_ct_path()}, {"labels", example_labels_path()}};
-  scene["render"] = {{"cameras", nlohmann::json::array()}, {"ports", nlohmann::json::array()}};
-  const std::string path = dir.file(name + ".json"), out = dir.file(name);
-  std::ofstream(path) << scene.dump(2);
-  const CliResult r = run_pneumo("-q run " + path + " --out " + out);
-  code = r.code;
-  err = r.err;
-  return r.code == 0 ? nlohmann::json::parse(slurp(out + "/metrics.json")) : nlohmann::json();
-}
-
-}  // namespace
 
 TEST(EveryModelOnTheRealCt, CorotationalAndNeoHookeanConvergeAt12MmHg) {
   PNEUMO_REQUIRE_REAL_CT();
   ScratchDir dir;
   for (const char* model : {"fem-corotational", "fem-neohookean"}) {
-    int code = -1;
-    std::string err;
-    const nlohmann::json m = run_model(dir, model, {{"model", model}}, code, err);
-    ASSERT_EQ(code, 0) << model << ": " << err;
+    nlohmann::json scene = {{"name", model}, {"load", {{"pressure_mmhg", 12}}}, {"material", {{"model", model}}}};
+    scene["inputs"] = {{"ct", example_ct_path()}, {"labels", example_labels_path()}};
+    const SceneRun run = run_scene(dir, model, scene);
+    ASSERT_EQ(run.code, 0) << model << ": " << run.err;
+    const nlohmann::json& m = run.metrics;
     EXPECT_TRUE(m["converged"].get<bool>()) << model << ": " << m["stop_reason"];
     EXPECT_EQ(m["inverted_tetrahedra"].get<int>(), 0) << model;
     // A rise and a cavity at all: 21 mm and 1.8 L for the linear law, 44 mm and 2.4 L for the default.

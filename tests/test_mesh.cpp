@@ -33,6 +33,29 @@ struct Voxels {
   Role& at(int64_t i, int64_t j, int64_t k) { return roles[g.linear_index(i, j, k)]; }
 };
 
+/// One cube of 4×4×4 wall voxels meshed alone (L = 4: one sample per voxel, at its centre), of HU
+/// `lower` in its lower half (k < 2) and `upper` above: what the tissue-mixing tests draw.
+struct HalfCube {
+  Voxels v{4, 4, 4, 1.0, Role::Wall};
+  std::vector<float> hu;
+  MeshOptions o;
+  HalfCube(float lower, float upper) : hu(v.roles.size()) {
+    for (int64_t k = 0; k < 4; ++k)
+      for (int64_t j = 0; j < 4; ++j)
+        for (int64_t i = 0; i < 4; ++i) hu[v.g.linear_index(i, j, k)] = k < 2 ? lower : upper;
+    o.cube_voxels = 4;
+    o.model = MeshModel::Wall;
+  }
+  VoxelRoles roles() const { return VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}; }
+  /// Calls f(tetrahedron, lower half?) for each voxel centre, with the tetrahedron that holds it.
+  template <class F>
+  static void each_sample(F f) {
+    for (int k = 0; k < 4; ++k)
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) f(lattice::tet_holding({(i + 0.5) / 4, (j + 0.5) / 4, (k + 0.5) / 4}, false), k < 2);
+  }
+};
+
 Mesh build(const Voxels& v, int L, MeshModel model = MeshModel::Wall, std::optional<Vec3> roi_min = std::nullopt,
            std::optional<Vec3> roi_max = std::nullopt) {
   MeshOptions o;
@@ -489,28 +512,18 @@ TEST(MeshTissue, ModulusIsHillsMeanOfTheVoxelsInEachTetrahedron) {
   // average below the Voigt average ½ (2 + 60) kPa = 31 kPa, which the Voigt mean alone gave (a mixed linear
   // tetrahedron cannot strain more in the fat than in the muscle). All fat gives 2 kPa in every tetrahedron
   // exactly, and the modulus by label alone (no CT) 60 kPa.
-  Voxels v(4, 4, 4, 1.0, Role::Wall);
-  std::vector<float> hu(v.roles.size());
-  for (int64_t k = 0; k < 4; ++k)
-    for (int64_t j = 0; j < 4; ++j)
-      for (int64_t i = 0; i < 4; ++i) hu[v.g.linear_index(i, j, k)] = k < 2 ? -100.0f : 50.0f;
+  HalfCube c(-100.0f, 50.0f);
   const VoxelYoungFn young = [](Role, int, float h) { return h <= -30.0f ? 2e3 : 60e3; };
-  MeshOptions o;
-  o.cube_voxels = 4;
-  o.model = MeshModel::Wall;
-  const Mesh half = build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}, o, young);
+  const Mesh half = build_mesh(c.roles(), c.o, young);
   ASSERT_EQ(half.tets.size(), 5u);
   double sum[5] = {0, 0, 0, 0, 0}, compliance[5] = {0, 0, 0, 0, 0};
   int n[5] = {0, 0, 0, 0, 0};
-  for (int k = 0; k < 4; ++k)
-    for (int j = 0; j < 4; ++j)
-      for (int i = 0; i < 4; ++i) {
-        const int t = lattice::tet_holding({(i + 0.5) / 4, (j + 0.5) / 4, (k + 0.5) / 4}, false);
-        const double e = k < 2 ? 2e3 : 60e3;
-        sum[t] += e;
-        compliance[t] += 1.0 / e;
-        ++n[t];
-      }
+  HalfCube::each_sample([&](int t, bool lower) {
+    const double e = lower ? 2e3 : 60e3;
+    sum[t] += e;
+    compliance[t] += 1.0 / e;
+    ++n[t];
+  });
   double ev = 0.0, vol = 0.0;
   int mixed = 0;
   for (int t = 0; t < 5; ++t) {
@@ -526,10 +539,9 @@ TEST(MeshTissue, ModulusIsHillsMeanOfTheVoxelsInEachTetrahedron) {
   }
   EXPECT_GE(mixed, 4);   // the corner tetrahedra reach across the mid-plane, and so does the central one
   EXPECT_LT(ev / vol, 0.9 * 31e3);
-  std::fill(hu.begin(), hu.end(), -100.0f);
-  const Mesh fat = build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}, o, young);
-  for (double e : fat.tet_young_pa) EXPECT_DOUBLE_EQ(e, 2e3);
-  const Mesh no_ct = build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr}, o, young);
+  const HalfCube fat(-100.0f, -100.0f);
+  for (double e : build_mesh(fat.roles(), fat.o, young).tet_young_pa) EXPECT_DOUBLE_EQ(e, 2e3);
+  const Mesh no_ct = build_mesh(VoxelRoles{c.v.g, c.v.roles.data(), nullptr}, c.o, young);
   for (double e : no_ct.tet_young_pa) EXPECT_DOUBLE_EQ(e, 60e3);
 }
 
@@ -538,32 +550,22 @@ TEST(MeshTissue, PoissonsRatioIsTheMeanOfTheVoxelsInEachTetrahedron) {
   // MeshOptions::poisson_for: each tetrahedron's ν is the mean over the voxel centres it holds, derived
   // here from the points alone; all lung gives 0.40 exactly. Without poisson_for the mesh leaves
   // tet_poisson to its caller (empty).
-  Voxels v(4, 4, 4, 1.0, Role::Wall);
-  std::vector<float> hu(v.roles.size());
-  for (int64_t k = 0; k < 4; ++k)
-    for (int64_t j = 0; j < 4; ++j)
-      for (int64_t i = 0; i < 4; ++i) hu[v.g.linear_index(i, j, k)] = k < 2 ? -800.0f : 50.0f;
+  HalfCube c(-800.0f, 50.0f);
   const VoxelYoungFn young = [](Role, int, float h) { return h <= -400.0f ? 1e3 : 60e3; };
-  MeshOptions o;
-  o.cube_voxels = 4;
-  o.model = MeshModel::Wall;
-  EXPECT_TRUE(build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}, o, young).tet_poisson.empty());
-  o.poisson_for = [](Role, int, float h) { return h <= -400.0f ? 0.40 : 0.45; };
-  const Mesh half = build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}, o, young);
+  EXPECT_TRUE(build_mesh(c.roles(), c.o, young).tet_poisson.empty());
+  c.o.poisson_for = [](Role, int, float h) { return h <= -400.0f ? 0.40 : 0.45; };
+  const Mesh half = build_mesh(c.roles(), c.o, young);
   ASSERT_EQ(half.tet_poisson.size(), 5u);
   double sum[5] = {0, 0, 0, 0, 0};
   int n[5] = {0, 0, 0, 0, 0};
-  for (int k = 0; k < 4; ++k)
-    for (int j = 0; j < 4; ++j)
-      for (int i = 0; i < 4; ++i) {
-        const int t = lattice::tet_holding({(i + 0.5) / 4, (j + 0.5) / 4, (k + 0.5) / 4}, false);
-        sum[t] += k < 2 ? 0.40 : 0.45;
-        ++n[t];
-      }
+  HalfCube::each_sample([&](int t, bool lower) {
+    sum[t] += lower ? 0.40 : 0.45;
+    ++n[t];
+  });
   for (int t = 0; t < 5; ++t) EXPECT_NEAR(half.tet_poisson[t], sum[t] / n[t], 1e-12) << "tetrahedron " << t;
-  std::fill(hu.begin(), hu.end(), -800.0f);
-  for (double nu : build_mesh(VoxelRoles{v.g, v.roles.data(), nullptr, hu.data()}, o, young).tet_poisson)
-    EXPECT_DOUBLE_EQ(nu, 0.40);
+  HalfCube lung(-800.0f, -800.0f);
+  lung.o.poisson_for = c.o.poisson_for;
+  for (double nu : build_mesh(lung.roles(), lung.o, young).tet_poisson) EXPECT_DOUBLE_EQ(nu, 0.40);
 }
 
 }  // namespace
