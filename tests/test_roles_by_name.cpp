@@ -66,6 +66,31 @@ TEST(RolesByName, TheScenesOwnListsAndKeysWin) {
   EXPECT_TRUE(scene_of(j).mesh.attached_labels.empty());
 }
 
+TEST(RolesByName, TheEchoLeavesTheNamedIdsToTheNames) {
+  // scene_used.json is the echo: the ids the names gave stay out of its lists, so running it again with
+  // the lungs held (roles.compliant_lungs false) holds them, where lists it wrote would keep them wall.
+  PNEUMO_REQUIRE_REAL_CT();
+  nlohmann::json j = inputs_only(example_labels_path());
+  j["roles"] = {{"wall_labels", {30}}};   // one id of the scene's own (sacrum) stays written
+  const Scene s = scene_of(j);
+  const nlohmann::json echo = s.echo();
+  EXPECT_EQ(echo["roles"]["wall_labels"], nlohmann::json::array({30}));
+  EXPECT_TRUE(echo["roles"]["viscera_labels"].empty());
+  EXPECT_TRUE(echo["roles"]["fixed_labels"].empty());
+  const Scene again = scene_of(echo);
+  EXPECT_EQ(again.roles.wall_labels, s.roles.wall_labels);
+  EXPECT_EQ(again.roles.viscera_labels, s.roles.viscera_labels);
+  EXPECT_EQ(again.roles.fixed_labels, s.roles.fixed_labels);
+  EXPECT_EQ(again.echo(), echo);
+  nlohmann::json held = echo;
+  held["roles"]["compliant_lungs"] = false;
+  const Scene fixed = scene_of(held);
+  for (int id : kHandLungs) {
+    EXPECT_TRUE(std::count(fixed.roles.fixed_labels.begin(), fixed.roles.fixed_labels.end(), id)) << id;
+    EXPECT_FALSE(std::count(fixed.roles.wall_labels.begin(), fixed.roles.wall_labels.end(), id)) << id;
+  }
+}
+
 TEST(RolesByName, VoxelsGetTheRolesOfTheHandWrittenScene) {
   PNEUMO_REQUIRE_REAL_CT();
   Progress::set_enabled(false);

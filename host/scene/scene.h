@@ -169,7 +169,8 @@ struct Scene {
   std::string folder;  // absolute folder relative paths were resolved against
 
   /// The full resolved scene, defaults included, every key present (unset ones as null): written
-  /// next to outputs, and parse_scene() of it gives this scene back.
+  /// next to outputs, and parse_scene() of it gives this scene back. The role lists hold the scene's
+  /// own ids, not those its label names gave (roles.ids_from_names), which parse_scene derives again.
   nlohmann::json echo() const;
 
   /// inputs.ct; throws InputError naming the scene when it is not given.

@@ -224,6 +224,21 @@ Scene load_scene(const std::string& path) { return parse_scene(read_scene_json(p
 
 Scene default_scene() { return Scene{}; }
 
-nlohmann::json Scene::echo() const { return scene_detail::scene_table().write(*this); }
+nlohmann::json Scene::echo() const {
+  nlohmann::json j = scene_detail::scene_table().write(*this);
+  // The ids the label names gave (roles.ids_from_names) are not the scene's own: the echo leaves them
+  // out of the role lists and a run of it derives them again, so a key that changes what the names
+  // decide (roles.compliant_lungs, by_name) takes effect instead of being overridden by lists it wrote.
+  if (!roles.ids_from_names.empty())
+    for (const char* key : {"wall_labels", "viscera_labels", "fixed_labels"}) {
+      nlohmann::json& list = j["roles"][key];
+      nlohmann::json kept = nlohmann::json::array();
+      for (const auto& id : list)
+        if (!std::binary_search(roles.ids_from_names.begin(), roles.ids_from_names.end(), id.get<int>()))
+          kept.push_back(id);
+      list = kept;
+    }
+  return j;
+}
 
 }  // namespace pneumo
