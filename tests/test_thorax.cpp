@@ -211,6 +211,13 @@ TEST(Thorax, TheLungTissueHoldsItsVesselsAndNotTheHeart) {
   const Thorax with_heart = find_thorax(t.hu.data(), t.body, t.g, &labelled);
   EXPECT_EQ(count(t, with_heart.lung_tissue, kHeart), 0);
   EXPECT_EQ(count(t, with_heart.lung_tissue, kLung), count(t, kLung));
+  // Asked for none (held lungs, the diaphragm metric): no closing, the rest the same.
+  ThoraxOptions none;
+  none.lung_closing_mm = 0.0;
+  const Thorax bare = find_thorax(t.hu.data(), t.body, t.g, nullptr, none);
+  EXPECT_TRUE(bare.lung_tissue.empty());
+  EXPECT_EQ(bare.lungs, th.lungs);
+  EXPECT_EQ(bare.chest, th.chest);
 }
 
 TEST(Thorax, CompliantLungsAreWallAndFixedLungsAreFixed) {

@@ -145,10 +145,12 @@ Thorax find_thorax(const float* hu, const std::vector<uint8_t>& body, const Geom
         chest += t.chest[v];
         lungs += t.lungs[v];
       }
-  t.lung_tissue = closing(lung_only, g, opt.lung_closing_mm);
+  if (opt.lung_closing_mm > 0.0) {
+    t.lung_tissue = closing(lung_only, g, opt.lung_closing_mm);
 #pragma omp parallel for schedule(static)
-  for (int64_t v = 0; v < n; ++v)
-    t.lung_tissue[v] = t.lung_tissue[v] && t.chest[v] && !(with_labels && (*labelled)[v] == 2);
+    for (int64_t v = 0; v < n; ++v)
+      t.lung_tissue[v] = t.lung_tissue[v] && t.chest[v] && !(with_labels && (*labelled)[v] == 2);
+  }
   const double voxel_ml = g.spacing_mm.prod() / 1000.0;
   t.chest_ml = double(chest) * voxel_ml;
   t.lung_ml = double(lungs) * voxel_ml;

@@ -37,7 +37,8 @@ struct ThoraxOptions {
   double min_lung_ml = 15.0;            // smaller parts are bubbles or bowel gas; a lung base cut by the
                                         // scan's top slice is tens of ml
   double lung_closing_mm = 6.0;         // the lungs' own vessels and bronchi, up to twice this across, are
-                                        // lung tissue (a morphological closing); the hilum's are wider
+                                        // lung tissue (a morphological closing); the hilum's are wider.
+                                        // 0: no lung_tissue (it costs two distance transforms)
 };
 
 struct Thorax {
@@ -45,7 +46,8 @@ struct Thorax {
   std::vector<uint8_t> chest;   // 1: a body voxel above the diaphragm's surface (lungs included)
   std::vector<uint8_t> lung_tissue;   // 1: the lungs with the vessels and bronchi inside them (a closing
                                       // of the aerated and labelled lung by lung_closing_mm, within the
-                                      // chest), the labelled heart and other chest structures excluded
+                                      // chest), the labelled heart and other chest structures excluded;
+                                      // empty when lung_closing_mm is 0
   double lung_ml = 0.0, chest_ml = 0.0;
   int lung_parts = 0;           // parts found by density
 };

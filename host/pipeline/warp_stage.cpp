@@ -17,10 +17,10 @@
 #include "io/volume_io.h"
 #include "image/png.h"
 #include "anatomy/body_mask.h"
-#include "pipeline/cavity_measures.h"
-#include "pipeline/organ_motion.h"
 #include "anatomy/thorax.h"
+#include "pipeline/cavity_measures.h"
 #include "pipeline/diaphragm_motion.h"
+#include "pipeline/organ_motion.h"
 #include "pipeline/skin_area.h"
 #include "pipeline/scene_stages.h"
 #include "render/render_volume.h"
@@ -399,7 +399,9 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
       j["wall_skin_area_change_fraction"] = skin.change();
     }
     // The diaphragm's rise into the chest (pipeline/diaphragm_motion.h), where a lung base is in view.
-    const Thorax thorax = find_thorax(w.roles.hu(), body, w.roles.geometry);
+    ThoraxOptions lungs_only;
+    lungs_only.lung_closing_mm = 0.0;   // the lungs' base is all it needs: no closing
+    const Thorax thorax = find_thorax(w.roles.hu(), body, w.roles.geometry, nullptr, lungs_only);
     const DiaphragmMotion diaphragm = diaphragm_motion(voxel_roles_of(w.roles), body, thorax.lungs, carry);
     if (diaphragm.columns > diaphragm.not_carried) {
       j["diaphragm_cranial_shift_mm"] = diaphragm.median_cranial_mm;

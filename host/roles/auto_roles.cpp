@@ -72,8 +72,7 @@ struct Chest {
 };
 
 Chest fix_the_chest(std::vector<Role>& role, const RoleRules& r, const Geometry& g, const float* hu,
-                                   const uint16_t* label, const std::vector<uint8_t>& body,
-                                   const std::vector<float>& depth_mm) {
+                    const uint16_t* label, const std::vector<uint8_t>& body, const std::vector<float>& depth_mm) {
   const int64_t n = int64_t(role.size());
   std::vector<uint8_t> labelled;
   if (r.auto_use_labels && label) {
@@ -90,16 +89,19 @@ Chest fix_the_chest(std::vector<Role>& role, const RoleRules& r, const Geometry&
       for (int64_t v = 0; v < n; ++v) labelled[v] = chest_id[label[v]];
     }
   }
-  const Thorax t = find_thorax(hu, body, g, labelled.empty() ? nullptr : &labelled);
+  ThoraxOptions opt;
+  if (!r.compliant_lungs) opt.lung_closing_mm = 0.0;   // held lungs need no lung tissue
+  const Thorax t = find_thorax(hu, body, g, labelled.empty() ? nullptr : &labelled, opt);
   std::vector<uint8_t> held(static_cast<std::size_t>(n));
   const float shell = float(r.auto_wall_thickness_mm);
   int64_t count = 0, lung = 0;
 #pragma omp parallel for schedule(static) reduction(+ : count, lung)
   for (int64_t v = 0; v < n; ++v) {
     held[v] = t.lungs[v] || (t.chest[v] && depth_mm[v] > shell);
+    const bool lung_tissue = r.compliant_lungs && t.lung_tissue[v];
     if (held[v] && role[v] == kUndecided)   // the lungs and their vessels compliant: the diaphragm rises into them
-      role[v] = r.compliant_lungs && t.lung_tissue[v] ? Role::Wall : Role::Fixed;
-    lung += t.lung_tissue[v] && role[v] == Role::Wall;   // found here or labelled lung by name
+      role[v] = lung_tissue ? Role::Wall : Role::Fixed;
+    lung += lung_tissue && role[v] == Role::Wall;   // found here or labelled lung by name
     count += held[v] && role[v] == Role::Fixed;
   }
   if (t.lung_ml > 0.0) {
