@@ -2,7 +2,7 @@
 // a block of label 5 moved by whole voxels shifts its centroid by exactly that many millimetres and
 // keeps its volume; a block doubled along one axis on a grid of half the spacing there keeps its
 // centroid and doubles its volume (+100 %); the cavity's label, labels not asked for and labels under
-// min_ml are left out.
+// min_ml are left out; the tissue's own change is the mean of J − 1 over the voxels at rest.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -61,4 +61,23 @@ TEST(OrganMotion, ABlockStretchedOnAFinerGridDoublesItsVolumeAboutTheSameCentroi
   EXPECT_TRUE(m[0].name.empty());
   EXPECT_NEAR(m[0].volume_change, 1.0, 1e-12);
   EXPECT_NEAR((m[0].shift_mm - Vec3(0, 0, 0)).norm(), 0.0, 1e-9) << m[0].shift_mm.transpose();
+}
+
+TEST(OrganMotion, TheTissuesVolumeChangeIsTheMeanOfJMinusOneOverItsVoxelsAtRest) {
+  // A J field that is 0.8 on the block's lower half in x and unknown (nothing moves it) elsewhere:
+  // the tissue loses a tenth of its volume, whatever the images say (here: unchanged). Without a J
+  // field there is no tissue figure.
+  const Geometry g = grid(Vec3(2, 2, 3));
+  std::vector<uint16_t> rest(std::size_t(g.voxel_count()), 0);
+  paint(rest, g, {2, 2, 2}, {9, 8, 9}, 5);   // x from 2 to 9: half the voxels below x = 6
+  const JacobianAtFn half = [&g](int64_t voxel, const Vec3& mm) -> std::optional<double> {
+    EXPECT_NEAR((g.to_world(Vec3(double(voxel % 20), double(voxel / 20 % 20), double(voxel / 400))) - mm).norm(), 0.0, 1e-9);
+    return voxel % 20 < 6 ? std::optional<double>(0.8) : std::nullopt;
+  };
+  const auto m = organ_motion(rest, g, rest, g, 250, {}, {5}, 1.0, half);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_NEAR(m[0].volume_change, 0.0, 1e-12);
+  ASSERT_TRUE(m[0].tissue_volume_change.has_value());
+  EXPECT_NEAR(*m[0].tissue_volume_change, -0.1, 1e-12);
+  EXPECT_FALSE(organ_motion(rest, g, rest, g, 250, {}, {5})[0].tissue_volume_change.has_value());
 }

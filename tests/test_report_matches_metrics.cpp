@@ -453,6 +453,7 @@ TEST(ReportMatchesMetrics, EveryFigureOfEveryKnownKeyIsItsMetric) {
                                  {"name", o ? "spleen" : "liver"},
                                  {"volume_ml", 1234.5 + 98.7 * o},
                                  {"volume_change_fraction", -0.0417 + 0.0123 * o},
+                                 {"tissue_volume_change_fraction", -0.0389 + 0.0111 * o},
                                  {"shift_right_mm", 1.234 - o},
                                  {"shift_anterior_mm", -4.321 + o},
                                  {"shift_superior_mm", 2.468 + o}});

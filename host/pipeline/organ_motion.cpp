@@ -31,7 +31,7 @@ std::vector<Sums> sums_of(const std::vector<uint16_t>& labels, const Geometry& g
 std::vector<OrganMotion> organ_motion(const std::vector<uint16_t>& rest, const Geometry& rest_grid,
                                       const std::vector<uint16_t>& deformed, const Geometry& deformed_grid,
                                       uint16_t skip, const std::map<int, std::string>& names,
-                                      const std::vector<int>& ids, double min_ml) {
+                                      const std::vector<int>& ids, double min_ml, const JacobianAtFn& jacobian) {
   std::vector<OrganMotion> out;
   if (int64_t(rest.size()) != rest_grid.voxel_count() || int64_t(deformed.size()) != deformed_grid.voxel_count())
     return out;
@@ -52,6 +52,21 @@ std::vector<OrganMotion> organ_motion(const std::vector<uint16_t>& rest, const G
       m.shift_mm = deformed_grid.to_world(a.index_sum / double(a.count)) - rest_grid.to_world(b.index_sum / double(b.count));
     out.push_back(m);
   }
+  if (!jacobian || out.empty()) return out;
+  std::vector<int> slot(65536, -1);
+  for (std::size_t o = 0; o < out.size(); ++o) slot[std::size_t(out[o].label)] = int(o);
+  std::vector<double> sum_j_minus_1(out.size(), 0.0);
+  for (int64_t k = 0; k < rest_grid.dims[2]; ++k)
+    for (int64_t j = 0; j < rest_grid.dims[1]; ++j)
+      for (int64_t i = 0; i < rest_grid.dims[0]; ++i) {
+        const int64_t v = rest_grid.linear_index(i, j, k);
+        const int o = slot[rest[std::size_t(v)]];
+        if (o < 0) continue;
+        if (const std::optional<double> J = jacobian(v, rest_grid.to_world(Vec3(double(i), double(j), double(k)))))
+          sum_j_minus_1[std::size_t(o)] += *J - 1.0;
+      }
+  for (std::size_t o = 0; o < out.size(); ++o)
+    out[o].tissue_volume_change = sum_j_minus_1[o] * ml_before / out[o].volume_ml;
   return out;
 }
 

@@ -373,8 +373,21 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
     std::vector<int> moving = scene.roles.wall_labels;
     moving.insert(moving.end(), scene.roles.viscera_labels.begin(), scene.roles.viscera_labels.end());
     nlohmann::json organs = nlohmann::json::array();
+    const PointMap& to_deformed = point_map();
+    const WarpMesh& mesh = w.warp_mesh;
+    const std::vector<Role>& role = w.roles.role;
+    const JacobianAtFn jacobian = [&to_deformed, &mesh, &role](int64_t voxel, const Vec3& rest_mm) -> std::optional<double> {
+      if (role.empty() || role[std::size_t(voxel)] == Role::Fixed) return std::nullopt;   // held: J = 1
+      const MappedPoint p = to_deformed.to_deformed(rest_mm);
+      if (!p.carried) return std::nullopt;
+      const auto& t = mesh.tets[std::size_t(p.tet)];
+      return signed_tet_volume(mesh.deformed_ijk(t[0]), mesh.deformed_ijk(t[1]), mesh.deformed_ijk(t[2]),
+                               mesh.deformed_ijk(t[3])) /
+             signed_tet_volume(mesh.rest_ijk[t[0]], mesh.rest_ijk[t[1]], mesh.rest_ijk[t[2]], mesh.rest_ijk[t[3]]);
+    };
     for (const OrganMotion& o : organ_motion(w.roles.label, w.roles.geometry, w.result.labels, w.output_grid,
-                                             uint16_t(scene.output.cavity_label), scene.roles.label_names, moving))
+                                             uint16_t(scene.output.cavity_label), scene.roles.label_names, moving,
+                                             1.0, jacobian)) {
       organs.push_back({{"label", o.label},
                         {"name", o.name},
                         {"volume_ml", o.volume_ml},
@@ -382,6 +395,8 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
                         {"shift_right_mm", o.shift_mm[0]},
                         {"shift_anterior_mm", o.shift_mm[1]},
                         {"shift_superior_mm", o.shift_mm[2]}});
+      if (o.tissue_volume_change) organs.back()["tissue_volume_change_fraction"] = *o.tissue_volume_change;
+    }
     if (!organs.empty()) j["organ_motion"] = organs;
   }
   // The wall's skin, stretched (pipeline/skin_area.h).
