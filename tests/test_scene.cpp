@@ -154,7 +154,8 @@ TEST(SceneDefaults, MatchMethodAndTable) {
   EXPECT_EQ(s.material.stiffening, 10.0);
   EXPECT_EQ(s.material.poisson_ratio, 0.45);
   EXPECT_EQ(s.material.viscera_young_kpa, 5.5);
-  EXPECT_EQ(s.material.viscera_poisson_ratio, 0.25);
+  EXPECT_EQ(s.material.viscera_poisson_ratio, 0.49);
+  EXPECT_EQ(s.material.liver_volume_loss, 0.12);
   EXPECT_EQ(s.material.fat_young_kpa, 3.0);
   EXPECT_EQ(s.solver.newmark_beta, 0.25);
   EXPECT_EQ(s.solver.newmark_gamma, 0.5);
@@ -574,13 +575,51 @@ TEST(SceneRules, TheLungsMaterialIsAeratedWallUnlabelledOrNamedLung) {
   EXPECT_EQ(s.young_kpa_for(Role::Wall, 19, -1000.0f), 60.0);
   EXPECT_DOUBLE_EQ(s.poisson_for(Role::Wall, 19, -1000.0f), 0.45);
   EXPECT_EQ(s.young_kpa_for(Role::Viscera, 0, -1000.0f), 5.5);
-  EXPECT_DOUBLE_EQ(s.poisson_for(Role::Viscera, 0, -1000.0f), 0.25);
+  EXPECT_DOUBLE_EQ(s.poisson_for(Role::Viscera, 0, -1000.0f), 0.49);
   s.material.label_young_kpa = {{14, 2.0, std::nullopt}};
   EXPECT_EQ(s.young_kpa_for(Role::Wall, 14, -850.0f), 2.0);
   EXPECT_DOUBLE_EQ(s.poisson_for(Role::Wall, 14, -850.0f), 0.45);   // its own E, its role's ν
   s.roles.compliant_lungs = false;
   EXPECT_EQ(s.young_kpa_for(Role::Wall, 0, -850.0f), 60.0);
   EXPECT_DOUBLE_EQ(s.poisson_for(Role::Wall, 0, -850.0f), 0.45);
+}
+
+TEST(SceneRules, TheLiverKeepsTheViscerasShearAndTakesTheBulkModulusItsBloodGives) {
+  // liver_volume_loss 0.12 at 12 mmHg (1.59987 kPa): K = p / -ln(0.88) = 12.516 kPa, the Kirchhoff mean
+  // stress of the neo-Hookean law at J = 0.88 under p. μ stays the viscera's, 5.5 / (2 × 1.49) kPa.
+  // Derived back from the E and ν the scene gives, so a slip in either formula shows.
+  Scene s = parse_scene(json::object(), kOrigin);
+  s.roles.liver_ids = {5};
+  const double e = s.young_kpa_for(Role::Viscera, 5, 60.0f), nu = s.poisson_for(Role::Viscera, 5, 60.0f);
+  const double mu = e / (2.0 * (1.0 + nu)), k = e / (3.0 * (1.0 - 2.0 * nu));
+  EXPECT_NEAR(mu, 5.5 / (2.0 * 1.49), 1e-12);
+  EXPECT_NEAR(k, 12.0 * 0.133322387415 / -std::log(0.88), 1e-9);
+  EXPECT_LT(nu, 0.49);   // the liver gives way more than the other viscera
+  // Not the liver, not viscera, its own E in label_young_kpa, or the effect off: the role's moduli.
+  EXPECT_EQ(s.young_kpa_for(Role::Viscera, 6, 60.0f), 5.5);
+  EXPECT_DOUBLE_EQ(s.poisson_for(Role::Viscera, 6, 60.0f), 0.49);
+  EXPECT_EQ(s.young_kpa_for(Role::Wall, 5, 60.0f), 60.0);
+  s.material.label_young_kpa = {{5, 4.0, std::nullopt}};
+  EXPECT_EQ(s.young_kpa_for(Role::Viscera, 5, 60.0f), 4.0);
+  EXPECT_DOUBLE_EQ(s.poisson_for(Role::Viscera, 5, 60.0f), 0.49);
+  s.material.label_young_kpa.clear();
+  s.material.liver_volume_loss.reset();
+  EXPECT_EQ(s.young_kpa_for(Role::Viscera, 5, 60.0f), 5.5);
+  // A loss so small that the bulk modulus would pass ν's bound of the table keeps ν at 0.49 and μ.
+  s.material.liver_volume_loss = 0.001;
+  EXPECT_DOUBLE_EQ(s.poisson_for(Role::Viscera, 5, 60.0f), 0.49);
+  EXPECT_DOUBLE_EQ(s.young_kpa_for(Role::Viscera, 5, 60.0f), 5.5);
+  // The springs have no bulk modulus to give it.
+  s.material.liver_volume_loss = 0.12;
+  s.material.model = MaterialModel::Msd;
+  EXPECT_EQ(s.young_kpa_for(Role::Viscera, 5, 60.0f), 5.5);
+}
+
+TEST(SceneRules, TheLiversIdsComeFromTheNamesTheLabelMapCarries) {
+  const std::string names = write_temp("liver_names.csv", "label_id,name\n1,spleen\n5,liver\n6,Liver Segment 4\n7,liver_tumor\n8,caudate lobe\n");
+  const std::string labels = write_temp("liver_labels.nii.gz", "");
+  Scene s = parse_scene({{"inputs", {{"labels", labels}, {"label_names", names}}}}, kOrigin);
+  EXPECT_EQ(s.roles.liver_ids, (std::vector<int>{5, 6, 8}));
 }
 
 // ---- files -------------------------------------------------------------------------------------

@@ -188,9 +188,10 @@ TEST(Simulate, RealCtInflatesWithFiniteElementsOnEveryDevice) {
   // scenes/totalseg_example.json (the default: Demiray's law, ν = 0.45, Newton) at 12 mm cubes, the preview
   // size. Compared against published adult figures at 12–15 mmHg (docs/fidelity.md): an anterior
   // rise of 25–60 mm (the range, from several centimetres in patients) and a cavity of more
-  // than 1 L (adults hold 2–4 L; the mesh's cavity without the warp's gas pieces measured 1.52 L).
-  // The viscera (5.5 kPa, ν 0.25: docs/fidelity.md §5) move back where the gas lies on them by at
-  // least the 5 mm (patients' bowel moves dorsally by centimetres; measured 5.75 mm here).
+  // than 1 L (adults hold 2–4 L). The viscera (5.5 kPa, ν 0.49, the liver's blood leaving it:
+  // docs/fidelity.md, "The viscera's volume") keep their tissue volume: the liver may lose its
+  // modelled 12 % (77 ml of 1.1 L measured) and the rest next to nothing, so the whole within 5 %
+  // (176 ml of 6.6 L measured, 2.7 %).
   // Then every OpenCL device against the CPU, within the device tolerance above.
   PNEUMO_REQUIRE_REAL_CT();
   Progress::set_enabled(false);
@@ -205,12 +206,9 @@ TEST(Simulate, RealCtInflatesWithFiniteElementsOnEveryDevice) {
   EXPECT_GE(d.anterior_rise_mm, 25.0);
   EXPECT_LE(d.anterior_rise_mm, 60.0);
   EXPECT_GT(d.cavity_volume_ml, 1000.0);
-  EXPECT_GE(d.anterior_viscera_posterior_motion_mm, 5.0);
-  // What that costs them: tissue volume, 11 % of theirs measured (791 of 7039 ml). A fifth would be
-  // a block collapsing, not the room outside the mesh the calibration stands for (docs/fidelity.md §5).
   const double viscera_ml = sim.roles.volume_ml(Role::Viscera);
   EXPECT_LT(d.viscera_volume_change_ml, 0.0);
-  EXPECT_GT(d.viscera_volume_change_ml, -0.2 * viscera_ml);
+  EXPECT_GT(d.viscera_volume_change_ml, -0.05 * viscera_ml);
   EXPECT_EQ(d.max_fixed_displacement_mm, 0.0);
   if (!testing_support::opencl_device_specs().empty()) expect_same_equilibrium_on_opencl(scene);
 }

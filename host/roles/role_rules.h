@@ -35,6 +35,9 @@ struct RoleRules {
   // The ids the label names call lung (filled by the scene, not a key): their aerated voxels, and
   // unlabelled ones, take the lungs' material; a labelled duodenum's or rectum's gas does not.
   std::vector<int> lung_ids;
+  // The ids the label names call liver (filled by the scene, not a key): they take the liver's
+  // vascular compliance (SceneMaterial::liver_volume_loss).
+  std::vector<int> liver_ids;
   bool auto_use_labels = true;
   // Ids the lists do not name take the role their structure's name gives (roles/structure_names.h).
   bool by_name = true;

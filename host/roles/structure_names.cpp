@@ -109,6 +109,11 @@ bool lies_above_the_diaphragm(const std::string& name) {
   return std::regex_match(normalised(name), chest);
 }
 
+bool is_liver(const std::string& name) {
+  static const std::regex liver("liver(_(lobe|segment)(_.*)?)?|(caudate|quadrate)_lobe", std::regex::optimize);
+  return std::regex_match(normalised(name), liver);
+}
+
 RolesFromNames roles_from_names(const std::map<int, std::string>& names, const std::vector<int>& skip) {
   const std::set<int> skipped(skip.begin(), skip.end());
   RolesFromNames r;

@@ -39,6 +39,10 @@ Compartment compartment_of(const std::string& name);
 /// chambers, the pulmonary vessels): what the thorax's diaphragm is found under (anatomy/thorax.h).
 bool lies_above_the_diaphragm(const std::string& name);
 
+/// Whether the name is the liver (or a lobe or segment of it): the organ whose blood the gas pressure
+/// drives out (SceneMaterial::liver_volume_loss).
+bool is_liver(const std::string& name);
+
 /// What a label map's names give the roles: ids (sorted) per role, the attached and prevesical ids,
 /// and the names the table does not know.
 struct RolesFromNames {

@@ -77,8 +77,15 @@ struct SceneMaterial {
   // ν of the finite elements (the springs' is fixed at 1/4): Bano 2012 used 0.49 for the wall.
   double poisson_ratio = 0.45;
   std::optional<double> wall_poisson_ratio;
-  // A calibration, not a tissue's ratio: the room the viscera find outside the mesh (docs/fidelity.md §5).
-  std::optional<double> viscera_poisson_ratio = 0.25;
+  // The viscera keep their volume, as organs and bowel contents do: nearly incompressible, the room
+  // the gas takes found by moving (mean_dilatation keeps such elements from locking).
+  std::optional<double> viscera_poisson_ratio = 0.49;
+  // The liver's blood, driven out by the gas: the fraction of its volume the liver loses at 12 mmHg
+  // (Nainamalai 2025: 12 % in 15 patients). It sets the liver's drained bulk modulus
+  // K = 12 mmHg / −ln(1 − loss), so that a liver under the gas pressure all round loses that fraction
+  // (the Kirchhoff mean stress of the neo-Hookean law is −K ln J); its shear modulus stays the
+  // viscera's. null = off (the liver is viscera like any other). docs/fidelity.md, "The viscera's volume".
+  std::optional<double> liver_volume_loss = 0.12;
   bool mean_dilatation = true;    // FEM: volumetric strain averaged per cube, against locking
   // b of the stiffening law (springs: solve/forces.h; fem-neohookean: Demiray); 0 = linear. 10 gives the
   // real CT McDougall's pressure-volume shape (docs/fidelity.md §3): a calibration.
@@ -188,6 +195,10 @@ struct Scene {
   /// Whether a voxel of this role, label and HU is lung tissue of the wall: aerated wall, unlabelled
   /// or of a label named lung (roles.lung_ids), with roles.compliant_lungs and lung_young_kpa set.
   bool is_lung_voxel(Role role, int label, float hu) const;
+  /// Whether a label takes the liver's vascular compliance: viscera of a label named liver
+  /// (roles.liver_ids), with liver_volume_loss set, no E of its own in label_young_kpa and finite
+  /// elements (the springs' ν is fixed).
+  bool takes_liver_compliance(Role role, int label) const;
 
   /// Kitasaka's k_v (kPa): volume_stiffness_kpa when set; unset: young_kpa for kitasaka2004
   /// (the 2004 scheme needs it: its springs alone let tetrahedra collapse), 0 for the others.

@@ -247,9 +247,13 @@ const Table<SceneMaterial>& material_table() {
       {"wall_poisson_ratio", &SceneMaterial::wall_poisson_ratio, "", in(0, 0.49),
        "ν of wall finite elements; unset = poisson_ratio."},
       {"viscera_poisson_ratio", &SceneMaterial::viscera_poisson_ratio, "", in(0, 0.49),
-       "ν of viscera finite elements; null = poisson_ratio. Default 0.25: a calibration, not a tissue's ratio (solid "
-       "organs are nearly incompressible); it lumps the room the viscera find outside the mesh (diaphragm, emptying "
-       "veins, bowel contents), so their anterior half moves back by 5 mm or more (docs/fidelity.md §5)."},
+       "ν of viscera finite elements; null = poisson_ratio. Default 0.49: organs and bowel contents keep their "
+       "volume, so the room the gas takes is found by moving, not shrinking (docs/fidelity.md, the viscera's volume)."},
+      {"liver_volume_loss", &SceneMaterial::liver_volume_loss, "", in(0.001, 0.5),
+       "The fraction of its volume the liver loses at 12 mmHg as the gas drives its blood out (Nainamalai 2025: 12 % "
+       "in 15 patients): the liver's bulk modulus K = 12 mmHg / -ln(1 - loss), its shear modulus the viscera's. "
+       "Applies to finite-element viscera of a label named liver (the springs' ν is fixed); null = off "
+       "(docs/fidelity.md, the viscera's volume)."},
       {"mean_dilatation", &SceneMaterial::mean_dilatation, "", any(),
        "FEM: average the volumetric strain over each cube's tetrahedra (B-bar), so nearly incompressible tissue does "
        "not lock; false = per tetrahedron (docs/fem.md)."},

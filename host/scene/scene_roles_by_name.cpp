@@ -62,8 +62,11 @@ void assign_roles_by_name(Scene& s, const nlohmann::json& given) {
   if (!exists(names_file)) return;
   r.label_names = scene_label_names(s);   // the messages name structures in every mode
   r.lung_ids.clear();                     // the lungs' material goes by name in every mode too
-  for (const auto& [id, name] : r.label_names)
+  r.liver_ids.clear();                    // and the liver's
+  for (const auto& [id, name] : r.label_names) {
     if (id > 0 && compartment_of(name) == Compartment::Lung) r.lung_ids.push_back(id);
+    if (id > 0 && is_liver(name)) r.liver_ids.push_back(id);
+  }
   if (r.source != RoleSource::Auto || !r.by_name || !r.auto_use_labels) return;
   const bool scene_lists = !r.wall_labels.empty() || !r.viscera_labels.empty() || !r.fixed_labels.empty();
   if (r.label_names.empty() && !scene_lists) {
