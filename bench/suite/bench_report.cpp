@@ -176,8 +176,8 @@ void material_models(std::ostringstream& md, const json& mm) {
        << num(r["wall_s"], "%.2f") << " |\n";
   if (!mm["real_ct"].empty()) {
     md << "\nThe real CT at each preset's cube size (all threads):\n\n| preset | model | solver | cube | nodes | s | "
-          "iterations | rise mm | cavity ml | viscera back mm | inverted | stop |\n"
-          "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+          "iterations | rise mm | cavity ml | viscera back mm | viscera volume % | inverted | stop |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& r : mm["real_ct"])
       md << "| " << r["preset"].get<std::string>() << " | " << r["model"].get<std::string>() << " | "
          << r["solver"].get<std::string>() << " | " << num(r["cube_mm"], "%g") << " mm | "
@@ -186,7 +186,10 @@ void material_models(std::ostringstream& md, const json& mm) {
          << (r.contains("anterior_rise_mm") ? num(r["anterior_rise_mm"], "%.1f") : "–") << " | "
          << (r.contains("cavity_volume_ml") ? num(r["cavity_volume_ml"], "%.0f") : "–") << " | "
          << (r.contains("viscera_posterior_motion_mm") ? num(r["viscera_posterior_motion_mm"], "%.1f") : "–") << " | "
-         << (r.contains("inverted_tetrahedra") ? r["inverted_tetrahedra"].dump() : "–") << " | "
+         << (r.contains("viscera_volume_change_fraction")
+                 ? num(json(100 * r["viscera_volume_change_fraction"].get<double>()), "%+.1f")
+                 : "–")
+         << " | " << (r.contains("inverted_tetrahedra") ? r["inverted_tetrahedra"].dump() : "–") << " | "
          << r["stop_reason"].get<std::string>() << " |\n";
   }
   const json& t = mm["throughput"];
@@ -214,7 +217,7 @@ void material_models(std::ostringstream& md, const json& mm) {
     if (c.contains("model_pick")) {
       const json& p = c["model_pick"];
       md << " the model to pick (the fastest real-CT row within the adult figures: rise 25–60 mm, 1.5–4 L, viscera "
-            "back ≥ 5 mm): ";
+            "keeping their volume within 5 %): ";
       if (p["model"].is_null()) md << "none in this run";
       else
         md << p["model"].get<std::string>() << " with " << p["solver"].get<std::string>() << " ("

@@ -72,7 +72,7 @@ struct SceneMaterial {
   double damping_ratio = 0.4;     // ζ, Nimura (§4)
   double spring_scale = 1.0;      // as published; 0.925 matches the lattice to E (§4)
   SpringModel spring_model = SpringModel::Nonlinear;  // rotation-invariant (§5)
-  // What `pneumo bench` picks at every preset (docs/fidelity.md §4): the springs cannot move the viscera.
+  // The elements (docs/fidelity.md §4): their ν is per role, so the viscera keep their volume.
   MaterialModel model = MaterialModel::FemNeoHookean;
   // ν of the finite elements (the springs' is fixed at 1/4): Bano 2012 used 0.49 for the wall.
   double poisson_ratio = 0.45;

@@ -240,8 +240,8 @@ const Table<SceneMaterial>& material_table() {
        "\"msd\": the mass-spring lattice (§4-5); \"fem-corotational\": co-rotational linear tetrahedra (as SOFA, "
        "Bano 2012); \"fem-neohookean\": neo-Hookean tetrahedra, with Demiray's stiffening when stiffening > 0. The "
        "FEM models need solver.method \"newton\" (the fast choice), \"static\" or \"implicit-euler\" (docs/fem.md). "
-       "The default is the model `pneumo bench` picks at every preset: only the elements move the viscera back by "
-       "the millimetres patients show (docs/fidelity.md §4)."},
+       "The default is the elements: their ν is per role, so the viscera keep their volume where the springs' ν is "
+       "fixed near 1/4; `pneumo bench` says per preset which model is fastest within the adult figures (docs/fidelity.md §4)."},
       {"poisson_ratio", &SceneMaterial::poisson_ratio, "", in(0, 0.49),
        "ν of the finite elements unless overridden (Bano 2012: 0.49 for the wall); the springs' ν is 1/4."},
       {"wall_poisson_ratio", &SceneMaterial::wall_poisson_ratio, "", in(0, 0.49),
