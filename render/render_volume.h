@@ -61,7 +61,7 @@ struct RenderVolume {
   bool contains(const Vec3& world_mm) const;
 };
 
-/// The CT as the views reconstruct it (issue 24, item 1): each axis convolved with a Gaussian of
+/// The CT as the views reconstruct it (docs/rendering.md): each axis convolved with a Gaussian of
 /// sigma_voxels[axis] voxels (truncated at 3σ and renormalised, the edge voxel repeated beyond the
 /// grid), so that the trilinear samples and the central-difference normals of the ray casters show
 /// tissue, not the voxel lattice. With integer HU (hu_is_int16) the result is rounded to whole HU
@@ -86,7 +86,7 @@ void smooth_for_views(RenderVolume& v, const Vec3& sigma_voxels);
 /// render.smoothing_mm = 0 shows the voxels as they are.
 Vec3 view_smoothing_sigma_voxels(const Geometry& g, double smoothing_mm);
 
-/// The views' grid (issue 19: a fine CT's views cost what a coarse one's do). Where the prefilter's
+/// The views' grid: a fine CT's views cost what a coarse one's do. Where the prefilter's
 /// σ spans f ≥ 2 voxels on an axis, the smoothed CT is sampled at every f-th voxel along it:
 /// f = ⌊σ/voxel⌋, so the new spacing f·h ≤ σ. A Gaussian of σ keeps exp(−2π²σ²ν²) of frequency ν,
 /// at the coarse grid's Nyquist ν = 1/(2fh) at most exp(−π²/2) = 0.7 %: the samples alias less than

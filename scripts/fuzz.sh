@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fuzzes the NIfTI, MetaImage and NRRD readers and the scene parser with libFuzzer (issue 9): installs
+# Fuzzes the NIfTI, MetaImage and NRRD readers and the scene parser with libFuzzer: installs
 # the project's dependencies plus clang and its fuzzer runtime (kept out of install_deps.sh so the
 # usual build stays lean), configures a clang build with -DPNEUMO_FUZZ=ON in build-fuzz/, and runs
 # the tests labelled "fuzz", each for PNEUMO_FUZZ_SECONDS (default 60). Idempotent.

@@ -139,7 +139,7 @@ TEST(Cli, DevicesListsTheReferenceAndOpenCL) {
 }
 
 TEST(Cli, ValidateJsonHasTheDocumentedKeys) {
-  // Compared: the keys issue 3 names for `validate lattice --json` and `validate lame-sphere --json`
+  // Compared: the keys of `validate lattice --json` and `validate lame-sphere --json` listed here
   // (users script against them), and the lattice's ratio against §4's 1.140 (±2 %).
   auto lat = run_pneumo("validate lattice --json");
   ASSERT_EQ(lat.code, 0) << lat.err;

@@ -1,6 +1,6 @@
 // `pneumo convert` writes nothing over an existing file unless told to (--force), and that holds for
 // every file a conversion writes: a .mhd header's data file (.raw) beside it too, which was
-// overwritten without --force while only the header's name was checked (issue 54).
+// overwritten without --force while only the header's name was checked.
 #include <gtest/gtest.h>
 
 #include <filesystem>

@@ -1,4 +1,4 @@
-// Cubes sized per axis (core/cube_voxels.h, issue 58 item 4): mesh.cube_mm gives each axis of the grid the
+// Cubes sized per axis (core/cube_voxels.h): mesh.cube_mm gives each axis of the grid the
 // whole number of voxels nearest to it, so cubes are near-cubic on anisotropic (clinical) grids.
 //  - The rounding: every edge within half a voxel of cube_mm (at least one voxel), the presets' sizes on a
 //    0.75 × 0.75 × 2.5 mm grid as the docs state them, and one L on every axis of an isotropic grid (the

@@ -1,4 +1,4 @@
-// Issue 9, determinism: the same scene on the same device gives bit-identical results and files from run
+// Determinism: the same scene on the same device gives bit-identical results and files from run
 // to run. Compared: two runs of `simulate` on the small phantom (12 mmHg, static solver, coarser cubes) in
 // one process, on the CPU reference with 2 OpenMP threads (the mesh is large enough for the force loop to
 // run in parallel) and on every OpenCL device: the final positions and the whole convergence history

@@ -1,5 +1,5 @@
-// Issue 9, "a mesh that would not fit in the device's memory is refused before allocating, with the
-// estimate": the estimates the solvers and the warp check against the device (ctx.check_fits) must
+// A mesh that would not fit in the device's memory is refused before allocating, with the
+// estimate: the estimates the solvers and the warp check against the device (ctx.check_fits) must
 // cover what they then allocate, or a case that passes the check can still fail half-way. Compared,
 // on every OpenCL device and for a mesh the pipeline built (the tiny case: small enough that the
 // fixed-size buffers and the one-entry paddings weigh in), the estimate against the sum of the sizes

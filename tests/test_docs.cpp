@@ -1,4 +1,4 @@
-// The project documents itself (issue "Outputs that open…", item 7): the README stays short enough
+// The project documents itself: the README stays short enough
 // to read in minutes, every link in it and in docs/ leads to a file of the repository, and every
 // "method.md §N" the code cites is a section of docs/method.md.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Issue "The abdomen expands as patients' does", item 4: every material model converges on the real CT
+// Every material model converges on the real CT
 // at 12 mmHg with its own defaults, as a user choosing it would run it (a scene of the inputs, the
 // pressure and the model). The co-rotational law is linear: with the default's 3 kPa fat it turned
 // tetrahedra inside out and stopped "without descent" (docs/fem.md); its defaults now leave the fat

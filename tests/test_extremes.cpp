@@ -1,4 +1,4 @@
-// Issue 9, numerical extremes: each test states what must happen when a parameter is pushed to the
+// Numerical extremes: each test states what must happen when a parameter is pushed to the
 // edge of what a scene allows (Δt around the stability limit, E from 1 kPa to 1 MPa, 0 to 60 mmHg,
 // damping ratio 0 and 2, cubes of 2 to 16 voxels, one cube, nothing free, an unanchored wall,
 // inverting tetrahedra, Newmark's inner loop at its cap): a clear answer or a clear refusal, never a
@@ -452,7 +452,7 @@ TEST(ExtremeMesh, OneCube) {
 
 TEST(ExtremeMesh, EverythingFixedIsRefusedByEverySolver) {
   // Compared: the slab with every node held, solved by each of the four solvers: an InputError saying
-  // nothing can move and what to change, before any step. Before issue 9 the dynamic solvers took Δt from
+  // nothing can move and what to change, before any step. Once the dynamic solvers took Δt from
   // a stable-step estimate that is infinite when no node is free, and ∞·0 made every position NaN.
   const OneThread one;
   Mesh m = slab();

@@ -533,7 +533,7 @@ TEST(FemLame, HollowSphereMatchesLamesClosedFormAndConverges) {
   // Compared: the mean radial displacement on the true spheres r = a and r = b of Lamé's sphere (a = 50,
   // b = 100 mm, E = 60 kPa, voxels a quarter of the cube, the mesh's field evaluated there) against the
   // closed form with the nominal moduli, at 10 and 5 mm cubes, one placement, for both FEM laws with
-  // the cube-averaged dilatation, at ν = 0.25 and 0.45. Tolerances, the issue's: within 3 % at 5 mm,
+  // the cube-averaged dilatation, at ν = 0.25 and 0.45. Tolerances, the project's (docs/fem.md): within 3 % at 5 mm,
   // and converging at first order or better, i.e. the error at 5 mm at most half that at 10 mm
   // (measured, four placements: −2.4/−1.5 → −0.6/−0.4 % at ν 0.25, −3.5/−3.2 → −0.9/−0.8 % at 0.45,
   // inner/outer, co-rotational; an observed order of about 2, as linear elements' displacements converge).

@@ -1,4 +1,4 @@
-// A disk that fills during `pneumo warp` (issue "Nothing lost, nothing silently wrong"): niftilib
+// A disk that fills during `pneumo warp`: niftilib
 // writes through gzwrite without checking it, and once left a truncated deformed_ct.nii.gz under its
 // final name, with two of its own error lines naming a temporary file. The disk is filled here by
 // a file-size limit on the process (RLIMIT_FSIZE, SIGXFSZ ignored, so writes past it fail with

@@ -1,4 +1,4 @@
-// Issue 9, hostile input end to end: a tiny case (tiny_case_support.h) with one piece spoiled at a
+// Hostile input end to end: a tiny case (tiny_case_support.h) with one piece spoiled at a
 // time (a truncated or corrupt volume, an absurd header, NaN or Inf voxels, labels off the CT's grid, a
 // mapping for another label map, scene keys of the wrong type or unit, missing or unwritable paths,
 // roles that leave nothing to move or a wall unanchored, a load that turns tetrahedra inside out with

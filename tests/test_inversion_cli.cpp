@@ -1,4 +1,4 @@
-// Issue 9, tetrahedra inverting under extreme load, end to end: the tiny case (tiny_case_support.h)
+// Tetrahedra inverting under extreme load, end to end: the tiny case (tiny_case_support.h)
 // made soft (E = 6 kPa, no volume-preserving force) under 12 mmHg turns tetrahedra inside out on
 // every solver and device (measured: 8 or 16 of 540 at the first check, 124 or 244 at equilibrium).
 // With solver.on_inverted = "stop", `pneumo simulate` and `pneumo run` must stop: exit 1 (pneumo

@@ -1,4 +1,4 @@
-// kill -9 during `pneumo run` (issue "Nothing lost, nothing silently wrong"): whatever moment it
+// kill -9 during `pneumo run`: whatever moment it
 // lands, every file under a final name is complete (JSON parses, NIfTI reads whole, PNG ends in its
 // IEND chunk), the lock dies with the process, and the next run into the folder removes the
 // temporary files the killed one left. Killed at four moments of a run.

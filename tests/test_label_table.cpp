@@ -1,6 +1,5 @@
 // Label names in (a CSV), label tables out (3D Slicer's .ctbl and ITK-SNAP's label description)
-// beside the deformed labels, so a user opening them sees organ names and the CO2 cavity named
-// (issue "Outputs that open in every tool", item 4).
+// beside the deformed labels, so a user opening them sees organ names and the CO2 cavity named.
 #include <gtest/gtest.h>
 
 #include <filesystem>

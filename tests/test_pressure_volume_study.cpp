@@ -18,8 +18,8 @@ TEST(PressureVolumeStudy, CurveComplianceAndFraction) {
   // Compared: the tiny case at the default pressures (0 … 30 mmHg), against what the study's fields mean:
   // one converged point per pressure in increasing order, 0 ml at 0 mmHg, the volume rising with pressure,
   // compliance = (V(15) − V(5)) / 10 and fraction = V(15) / V(30) from those points (exact: the same
-  // numbers); the default material's fraction above the 0.6 (stiffening), and Nimura's linear lattice's
-  // near a linear wall's ½ (0.4 … 0.6: geometric nonlinearity only). Pressures without 5, 15 or 30 mmHg are an
+  // numbers); the default material's fraction above 0.6 (stiffening; patients 0.67, docs/fidelity.md
+  // §4), and Nimura's linear lattice's near a linear wall's ½ (0.4 … 0.6: geometric nonlinearity only). Pressures without 5, 15 or 30 mmHg are an
   // InputError before anything is solved.
   ScratchDir d;
   const Scene scene = load_scene(write_tiny_case(d));

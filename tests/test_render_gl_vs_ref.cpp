@@ -2,7 +2,7 @@
 // here) against the CPU reference (render/ray_cast_ref.cpp) on the analytic cavity phantom
 // (render_test_support.h): a gas sphere in soft tissue with a labelled organ bulging into it.
 //
-// Compared: the 8-bit RGB images by PSNR, threshold 35 dB (the issue's). Why not bit-exact: the GL
+// Compared: the 8-bit RGB images by PSNR, threshold 35 dB (images that look the same). Why not bit-exact: the GL
 // side samples in float32 with the driver's own trilinear filtering and a 1-HU transfer-function
 // table, the reference in double with the piecewise-linear function itself; these move a few
 // samples across steep transfer-function ramps. A wrong ray, step, opacity correction, shading

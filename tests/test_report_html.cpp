@@ -56,7 +56,7 @@ TEST(ReportHtml, EmbedsImagesAndPlotsAndReferencesNothingOutside) {
 }
 
 TEST(ReportHtml, ReadsInTheOrderAReaderAsks) {
-  // Compared: issue 20's list for a surgeon-researcher's page: the outcome in words (not "Converged
+  // Compared: what a surgeon-researcher's page needs, in order: the outcome in words (not "Converged
   // (converged)"), then the views with their captions, the fly-through, the slices, the solver, the
   // time in pipeline order (roles before mesh before solve ..., not alphabetical), every metric by name
   // and unit, a fraction shown in %, and the scene folded away last.

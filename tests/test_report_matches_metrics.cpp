@@ -1,4 +1,4 @@
-// report.html against metrics.json (issue 58): every figure the page shows is the metric it names,
+// report.html against metrics.json: every figure the page shows is the metric it names,
 // read back from the HTML and checked without the report's own scale table: the number shown,
 // divided by 100 where its unit is "%" (a fraction) and by 1 otherwise, is the stored value to the
 // 4 significant digits the page prints; booleans are yes/no; strings are themselves. The unit shown
@@ -409,7 +409,7 @@ json distinctive_value(const std::string& key, int i) {
   static const std::set<std::string> kCounts = {"steps", "force_evaluations", "inner_iterations", "nodes",
                                                 "tetrahedra", "springs", "fixed_nodes", "cavity_voxels",
                                                 "inverted_tetrahedra", "warp.carried_voxels", "render.views"};
-  if (key == "viscera_volume_change_ml") return -673.8;   // issue 58: shown as "−0 ml"
+  if (key == "viscera_volume_change_ml") return -673.8;   // once shown as "−0 ml"
   if (key == "render.deformed_ct") return false;
   if (kBooleans.count(key)) return true;
   if (kStrings.count(key)) return key + " <&> \"text\"";
@@ -519,7 +519,7 @@ TEST(ReportMatchesMetrics, ARealRunsReportIsItsMetricsJson) {
   const json m = json::parse(testing_support::read_bytes(d.file("run/metrics.json")));
   ASSERT_TRUE(m.contains("pressure_curve"));
   ASSERT_TRUE(m.contains("landmarks"));
-  // The mesh's size in the user's terms (issue 58 item 4): the cube's edge per axis in mm and the
+  // The mesh's size in the user's terms: the cube's edge per axis in mm and the
   // element count, both in metrics.json and so, by the check below, on the page.
   ASSERT_TRUE(m.contains("cube_edge_mm"));
   ASSERT_EQ(m["cube_edge_mm"].size(), 3u);

@@ -158,7 +158,7 @@ TEST(RolesByName, LabelsModeKeepsItsListsButItsMessagesNameTheStructures) {
 }
 
 TEST(RolesByName, ArterialContrastInTheNamedVesselsAndOrgansChangesNoRole) {
-  // The contrast case: on an arterial-phase CT the aorta reads 350-450 HU and the kidneys' cortex
+  // A contrast CT: on an arterial-phase CT the aorta reads 350-450 HU and the kidneys' cortex
   // and the spleen enhance, above the 250 HU bone rule. Structures the label map names keep the role of
   // their name whatever their HU; the aorta, IVC, portal and iliac vessels raised to 400 HU, the kidneys
   // and spleen to 260 HU, must leave every voxel's role as it was.

@@ -52,7 +52,7 @@ double lit_fraction(const fs::path& png) {
 }  // namespace
 
 TEST(RunPipeline, SmallPhantomEndToEnd) {
-  // Compared: the folder a run leaves against issue 7's list (every file present and readable, the deformed
+  // Compared: the folder a run leaves against the files listed below (every file present and readable, the deformed
   // volumes on the input CT's grid), and the results against physics: the wall rises (> 5 mm: see the
   // simulate tests), a cavity opens (> 50 ml of warped gas), no tetrahedron inverts, every view shows
   // something (≥ 10 % lit pixels: a view of the gas layer shows its walls everywhere; the exterior views show
@@ -237,7 +237,7 @@ TEST(RunPipeline, RealCtEndToEnd) {
   EXPECT_GT(m.at("anterior_rise_mm").get<double>(), 5.0);
   EXPECT_GT(m.at("cavity_volume_ml").get<double>(), 20.0);
   EXPECT_EQ(m.at("inverted_tetrahedra").get<int64_t>(), 0);
-  // The issue "A human answer"'s gas targets (docs/fidelity.md §2): one connected cavity (≤ 1 % of it
+  // The gas targets (docs/fidelity.md §2): one connected cavity (≤ 1 % of it
   // outside its largest piece; measured 0.52 %), and no gas in the space of Retzius. Gas does lie in
   // front of the bladder's top with no bowel between in the deformed frame (1.16 ml), on tissue a
   // sigmoid loop covered at rest: the supravesical fossa, which the traced measure leaves out.

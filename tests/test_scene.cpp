@@ -286,7 +286,7 @@ TEST(SceneErrors, OutOfRangeSamples) {
       {{{"material", {{"damping_ratio", -1}}}}, "material.damping_ratio", "-1", "allowed: 0 to 10"},
       {{{"material", {{"young_kpa", 0}}}}, "material.young_kpa", "0", "allowed: 0.1 to 1000000 kPa"},
       // Values that parse yet make the forces vanish against rounding (NaN, or no end): refused at
-      // the physical floors (issue "Nothing lost, nothing silently wrong").
+      // the physical floors.
       {{{"material", {{"young_kpa", 1e-100}}}}, "material.young_kpa", "1e-100", "allowed: 0.1 to 1000000 kPa"},
       {{{"material", {{"wall_young_kpa", 1e-300}}}}, "material.wall_young_kpa", "1e-300", "allowed: 0.1 to 1000000 kPa"},
       {{{"material", {{"label_young_kpa", {{{"label", 3}, {"young_kpa", 1e-300}}}}}}},

@@ -187,7 +187,7 @@ TEST(Simulate, OpenClReachesTheCpuEquilibriumOnTheRealCt) {
 TEST(Simulate, RealCtInflatesWithFiniteElementsOnEveryDevice) {
   // scenes/totalseg_example.json (the default: Demiray's law, ν = 0.45, Newton) at 12 mm cubes, the preview
   // size. Compared against published adult figures at 12–15 mmHg (docs/fidelity.md): an anterior
-  // rise of 25–60 mm (the range, from several centimetres in patients) and a cavity of more
+  // rise of 25–60 mm (from several centimetres in patients) and a cavity of more
   // than 1 L (adults hold 2–4 L). The viscera (5.5 kPa, ν 0.49, the liver's blood leaving it:
   // docs/fidelity.md, "The viscera's volume") keep their tissue volume: the liver may lose its
   // modelled 12 % (77 ml of 1.1 L measured) and the rest next to nothing, so the whole within 5 %

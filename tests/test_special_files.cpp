@@ -1,4 +1,4 @@
-// Issue 54, "nothing run that the user did not ask for": every input pneumo reads is a regular file
+// Nothing run that the user did not ask for: every input pneumo reads is a regular file
 // (core/input_file.h). A FIFO given as a scene, a CT or a NRRD's data file made pneumo wait forever;
 // a link to /dev/zero as the scene grew to gigabytes (the 16 MB cap was skipped when the size could
 // not be read). Each is now refused at once: exit 2, one line naming the file and what it is. Every

@@ -1,6 +1,6 @@
 // The fly-through and inflation-preview videos: ffmpeg is installed by scripts/install_deps.sh,
-// and an MP4 plays its frames at render.video_fps, every PNG one frame (issue 20: 24 frames played
-// in 0.96 s, at a rate no key could change). Checked with ffprobe, ffmpeg's own reader.
+// and an MP4 plays its frames at render.video_fps, every PNG one frame (24 frames once
+// played in 0.96 s, at a rate no key could change). Checked with ffprobe, ffmpeg's own reader.
 #include <gtest/gtest.h>
 
 #include <cstdio>

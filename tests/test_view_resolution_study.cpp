@@ -1,7 +1,7 @@
 // `pneumo validate view-resolution` (pipeline/view_resolution_study.h) on the small and medium
 // phantoms at 96×72 px. Compared against what the study claims: every view at every size and
 // shading, each PNG written; the finest size is its own reference (SSIM 1); a coarser one scores in
-// (0, 1); and the point, that the smooth views of 4 and 1.5 mm agree better than the voxel
+// (0, 1); and the point of it, that the smooth views of 4 and 1.5 mm agree better than the voxel
 // views do, for the laparoscope's port view after inflation (measured at 512×384: 0.55 → 0.85).
 // The command refuses sizes listed fine to coarse before any work.
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // The output grid grown to hold a deformed body that left the working grid (warp_mesh.h
-// growth_to_hold_deformed and grown_warp_mesh, roles.h grown_roles; issue "A human answer",
-// item 5). Truths: a body translated out of the grid by whole voxels is carried whole into the grown
+// growth_to_hold_deformed and grown_warp_mesh, roles.h grown_roles). Truths: a body translated out
+// of the grid by whole voxels is carried whole into the grown
 // grid (every voxel it carried at rest, none clipped); on the original grid's voxels the grown warp
 // is the original warp bit for bit (the rest-space table and index shift agree) but for tissue
 // sampled in the last half voxel of a face that grew, which the original clamps to the edge voxel

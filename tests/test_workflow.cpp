@@ -1,4 +1,4 @@
-// The cohort workflow (workflow/Snakefile, docs/workflow.md; issue "A clinical-size case…", item 5): the shipped
+// The cohort workflow (workflow/Snakefile, docs/workflow.md): the shipped
 // example config, run by Snakemake from the repository root with 2 cores as a user would, only its output
 // folder moved to a scratch folder and the pneumo binary named. Compared: the gathered table holds one row per
 // case × setting (the small phantom and the real CT, each at 10 and 15 mmHg), every run finished and converged,

@@ -210,7 +210,7 @@ json measure_throughput(BenchContext& ctx) {
   }
   return {{"case", c.name}, {"model", "fem-neohookean, b = 10, nu " + std::to_string(c.scene.material.poisson_ratio)},
           {"nodes", c.mesh.node_count()}, {"rows", rows},
-          {"peer", {{"source", "SofaCUDA TetrahedronFEM as published (issue \"Bano's row\"): 2.6 ms per implicit "
+          {"peer", {{"source", "SofaCUDA TetrahedronFEM as published: 2.6 ms per implicit "
                                "Euler step at 19 k nodes on an RTX 2070"},
                     {"nodes", 19000}, {"ms_per_step", 2.6},
                     {"comparable", "not directly: a step there holds its CG iterations (each a product like "

@@ -1,5 +1,5 @@
 #pragma once
-// The material models side by side (bench_suite.h, "material_models"; issue "Bano's row"):
+// The material models side by side (bench_suite.h, "material_models"):
 //   lame        Lamé's hollow sphere (method.md §10; ν 0.25 and 0.45) for the springs and each FEM law, at each
 //               cube size: the error against the closed form (truth outside the code) and the solve time, on the
 //               CPU and, for the finite elements, on every OpenCL device;

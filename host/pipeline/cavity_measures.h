@@ -1,6 +1,6 @@
 #pragma once
-// Measures of where the gas went and how the viscera moved, for the fidelity targets of the issue
-// "A human answer" (docs/fidelity.md): gas in front of an extraperitoneal organ, and the viscera's
+// Measures of where the gas went and how the viscera moved, for the fidelity targets of
+// docs/fidelity.md §2 and §5: gas in front of an extraperitoneal organ, and the viscera's
 // posterior motion where the gas pushes them.
 #include <cstdint>
 #include <functional>

@@ -1,5 +1,5 @@
 #pragma once
-// How far the diaphragm rose (issue "The abdomen expands as patients' does", item 5). The gas pushes
+// How far the diaphragm rose (docs/fidelity.md, "The diaphragm"). The gas pushes
 // the diaphragm into the chest where the lungs give way (roles.compliant_lungs); the lungs' base is
 // the diaphragm's thoracic face. Per axial column of the CT's own box that holds lung over tissue,
 // the lowest lung voxel's lower face centre is carried through the deformation and its cranial

@@ -1,5 +1,5 @@
 #pragma once
-// Where each labelled structure went (issue "The abdomen expands as patients' does", item 5): its
+// Where each labelled structure went: its
 // volume at rest and deformed, and the shift of its centroid in world millimetres (RAS), from the
 // label map before and after the warp, so the figures are those of the images a user opens. The
 // deformed map is the warp's nearest-label image (warp.h): a structure's deformed volume counts the

@@ -1,5 +1,5 @@
 #pragma once
-// Port planning on a solved, warped case (issue 22, docs/ports.md): the ranking of plan/port_ranking.h
+// Port planning on a solved, warped case (docs/ports.md): the ranking of plan/port_ranking.h
 // with its candidates carried back to the CT as given (where a plan's ports are written: they travel
 // with the skin), as the JSON table `pneumo ports` writes and the page reads, and as a heat map on the
 // exterior view of the inflated body.

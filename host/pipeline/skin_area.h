@@ -1,6 +1,6 @@
 #pragma once
-// The wall's skin before and after the inflation (issue "The abdomen expands as patients' does", item
-// 5): Song et al. 2006 (Surg Endosc, 18 patients, 12 mmHg) measured the abdominal wall's area growing by
+// The wall's skin before and after the inflation: Song et al. 2006 (Surg Endosc, 18 patients,
+// 12 mmHg) measured the abdominal wall's area growing by
 // 15 %. The skin here is every face between a wall voxel and the air outside the body within the CT's
 // own box (faces toward the padding around it, where the CT cut the body, are no skin; nor are faces
 // toward tissue left out inside the body); each face's corners are carried through the deformation

@@ -1,5 +1,5 @@
 #pragma once
-// `pneumo validate view-resolution` (issue 24, item 4): does the laparoscope's view depend on the CT's
+// `pneumo validate view-resolution`: does the laparoscope's view depend on the CT's
 // resolution? The phantom (an analytic body in mm, phantom.h) imaged at 4, 1.5 and 0.75 mm and
 // rendered from the same cameras: a scope in the stomach's gas looking at its wall, the anterior
 // exterior view of the skin, and the scene's umbilical port after inflation. One solve (on the

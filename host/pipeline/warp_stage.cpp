@@ -96,7 +96,7 @@ void fill_rounded(Volume& v, const std::vector<float>& hu) {
 
 /// Grows the working grid (roles and warp mesh together) wherever the deformed body leaves it, by
 /// air: the deformed CT then holds the whole body, and a dome that rises out of the CT and its
-/// padding is not clipped (issue "A human answer", item 5).
+/// padding is not clipped (docs/warp.md).
 void grow_to_hold_the_deformed_body(WarpedCase& w) {
   const Vec3& s = w.roles.geometry.spacing_mm;
   const Index3 cap{int64_t(kMaxGridGrowthMm / s[0]), int64_t(kMaxGridGrowthMm / s[1]),
@@ -329,7 +329,7 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
   j["deformed_body_outside_grid_mm"] = w.outside_grid_mm;
   j["cavity_voxels"] = w.cavity_voxels();
   j["cavity_volume_ml"] = w.cavity_volume_ml();
-  // The gas should be one connected cavity (issue "A human answer"): the share of it outside its
+  // The gas should be one connected cavity (docs/fidelity.md §2): the share of it outside its
   // largest 6-connected piece shows specks and pockets that opened apart from it.
   if (!w.result.labels.empty()) {
     std::vector<uint8_t> gas(w.result.labels.size());

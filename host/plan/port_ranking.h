@@ -1,5 +1,5 @@
 #pragma once
-// Ranking candidate ports on the inflated skin for one target (issue 22, docs/ports.md): what a
+// Ranking candidate ports on the inflated skin for one target (docs/ports.md): what a
 // surgeon weighs when choosing where a trocar goes, measured on the deformed labels and CT.
 //
 // Candidates lie on a regular grid over the anterior skin (the first voxel at or above skin_hu,

@@ -1,5 +1,5 @@
 #pragma once
-// What `pneumo serve` keeps resident for one case (issue 22): the scene, its roles and mesh, the
+// What `pneumo serve` keeps resident for one case: the scene, its roles and mesh, the
 // current equilibrium, the CT warped through it and the renderer holding that volume. A pressure or
 // stiffness change continues from the last equilibrium (a warm start: the solver starts at its shape
 // and pressure), and while it converges the warped volume is refreshed every kShapeRefreshSeconds,

@@ -1,5 +1,5 @@
 #pragma once
-// Frictionless penalty contact (issue "Bano's row", item 4): the viscera must not pass through the
+// Frictionless penalty contact (docs/contact.md): the viscera must not pass through the
 // wall or through bone when gravity, a tilt or a low pressure pushes them together.
 //
 // The surfaces are the voxel faces of mesh.h's ContactFaces: each viscera face (the slave) is a point

@@ -1,5 +1,5 @@
 #pragma once
-// The constitutive laws of the tetrahedral finite elements (issue "Bano's row", docs/fem.md), on one
+// The constitutive laws of the tetrahedral finite elements (docs/fem.md), on one
 // element's deformation gradient F = D_s D_m⁻¹ (D_s, D_m the current and rest edge matrices). Plain
 // double-precision reference code. Each law is split into a deviatoric part ψ_d(F) and a dilatation
 // measure e(F) with the volumetric energy ½λe², so that the volumetric part can be averaged over a

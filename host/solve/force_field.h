@@ -1,5 +1,5 @@
 #pragma once
-// One interface for every material model's forces on the mesh (issue "One shape for every stage"):
+// One interface for every material model's forces on the mesh:
 // the springs of method.md §5 (spring_force_field.cpp) and the tetrahedral finite elements
 // (fem_force_field.cpp) implement it, and the solvers see only this. A new material model is a new
 // implementation and one line in make_force_field().

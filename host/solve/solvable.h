@@ -1,5 +1,5 @@
 #pragma once
-// What a mesh must offer before any solver runs on it (issue 9): something free to move, and no
+// What a mesh must offer before any solver runs on it: something free to move, and no
 // part the load would carry away as a rigid body. Both are properties of the case (its roles, its
 // region of interest), not of the solver: they are refused as InputError, before the first step,
 // with what to change, instead of a run that never converges or "diverges" with advice about Δt.

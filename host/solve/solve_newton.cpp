@@ -1,5 +1,5 @@
 // Static equilibrium by Newton's method with matrix-free preconditioned conjugate gradients, on any
-// force field (force_field.h): the springs or the finite elements (issue "Bano's row").
+// force field (force_field.h): the springs or the finite elements (docs/fem.md).
 //
 // Each Newton iteration solves K d = f(x) for the step d (newton_linear_solver.h: on the host, or on
 // the OpenCL device that holds the force field), with K = −∂f/∂x the stiffness at x (the

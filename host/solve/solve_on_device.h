@@ -1,6 +1,6 @@
 #pragma once
-// The one entry through which the pipeline and the benchmarks solve (issue "One shape for every
-// stage"): the device is chosen here, not by each caller. A new back end is a new case here.
+// The one entry through which the pipeline and the benchmarks solve: the device is chosen here,
+// not by each caller. A new back end is a new case here.
 #include <vector>
 
 #include "cl/cl_runtime.h"

@@ -56,7 +56,7 @@ void check_warp_mesh(const WarpMesh& m);
 WarpMesh make_warp_mesh(const Mesh& mesh, const std::vector<Vec3>& displacement_m);
 
 /// How much to grow m.grid so that every deformed node lies in one of its voxels' cells: the output
-/// grid of a body that moved out of the CT (issue "A human answer", item 5). Whole cubes at the low
+/// grid of a body that moved out of the CT. Whole cubes at the low
 /// ends (of that axis's L), so that cube a keeps its place [aL − ½, (a+1)L − ½) in the lattice after the shift; single
 /// voxels at the high ends; nothing on a side the nodes stay inside. No end grows by more than
 /// `max_voxels` on its axis (rounded down to whole cubes at the low ends): a node flung far by a

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""`pneumo serve`'s page in a real browser (issue 22, item 7): headless Chromium driven by Selenium
+"""`pneumo serve`'s page in a real browser: headless Chromium driven by Selenium
 opens the page (the scene's ports listed), waits for the first equilibrium, clicks the skin on the
 body's view to place a port,
 waits for the laparoscope's view, moves the pressure slider down, waits for the view to change and
