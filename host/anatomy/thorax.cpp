@@ -102,12 +102,9 @@ Thorax find_thorax(const float* hu, const std::vector<uint8_t>& body, const Geom
     t.lung_parts = mark_lungs_by_density(hu, aerated, g, opt, t.lungs);
   }
   const bool with_labels = labelled && int64_t(labelled->size()) == n;
-  std::vector<uint8_t> lung_only = t.lungs;   // density and labelled lung, not the heart
   if (with_labels)
-    for (int64_t v = 0; v < n; ++v) {
-      t.lungs[v] |= (*labelled)[v] && body[v];
-      lung_only[v] |= (*labelled)[v] == 1 && body[v];
-    }
+    for (int64_t v = 0; v < n; ++v) t.lungs[v] |= (*labelled)[v] && body[v];
+  const auto labelled_heart = [&](int64_t v) { return with_labels && (*labelled)[v] == 2; };
 
   // The diaphragm's upper surface per column: the lowest lung voxel, as a superior index (0 = the
   // most inferior slice), -1 where the column holds no lung.
@@ -146,10 +143,12 @@ Thorax find_thorax(const float* hu, const std::vector<uint8_t>& body, const Geom
         lungs += t.lungs[v];
       }
   if (opt.lung_closing_mm > 0.0) {
+    std::vector<uint8_t> lung_only(t.lungs.size());   // density and labelled lung, not the heart
+#pragma omp parallel for schedule(static)
+    for (int64_t v = 0; v < n; ++v) lung_only[v] = t.lungs[v] && !labelled_heart(v);
     t.lung_tissue = closing(lung_only, g, opt.lung_closing_mm);
 #pragma omp parallel for schedule(static)
-    for (int64_t v = 0; v < n; ++v)
-      t.lung_tissue[v] = t.lung_tissue[v] && t.chest[v] && !(with_labels && (*labelled)[v] == 2);
+    for (int64_t v = 0; v < n; ++v) t.lung_tissue[v] = t.lung_tissue[v] && t.chest[v] && !labelled_heart(v);
   }
   const double voxel_ml = g.spacing_mm.prod() / 1000.0;
   t.chest_ml = double(chest) * voxel_ml;
