@@ -25,7 +25,7 @@ namespace pneumo {
 namespace {
 
 const uint32_t kSeed = 20261202u;
-const Lame kLame = Lame::from_young_poisson(60e3, 0.45);
+const TetMaterial kLame = TetMaterial::from_young_poisson(60e3, 0.45);
 
 Mat3 rotation(const Vec3& axis, double angle) { return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix(); }
 

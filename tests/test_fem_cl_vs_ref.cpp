@@ -77,7 +77,7 @@ std::vector<double> scales(const RandomCase& c, const std::vector<Vec3>& y, bool
     const TetRest rest = tet_rest(m.rest_m[q[0]], m.rest_m[q[1]], m.rest_m[q[2]], m.rest_m[q[3]]);
     const Mat3 D = edge_matrix(y[q[0]], y[q[1]], y[q[2]], y[q[3]]) * rest.dm_inverse;
     const double h = product ? D.norm() : (D - Mat3::Identity()).norm() + 1.0;
-    const Lame l = Lame::from_young_poisson(m.tet_young_pa[t], m.tet_poisson[t]);
+    const TetMaterial l = TetMaterial::from_young_poisson(m.tet_young_pa[t], m.tet_poisson[t]);
     const double k = l.lambda + l.mu;
     const Mat3& Di = rest.dm_inverse;
     const Vec3 grads[4] = {-(Di.row(0) + Di.row(1) + Di.row(2)).transpose(), Di.row(0).transpose(),

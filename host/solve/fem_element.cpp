@@ -71,7 +71,7 @@ ElementState element_state(FemLaw law, const Mat3& F, double b) {
   return s;
 }
 
-double volumetric_modulus(FemLaw law, const Lame& m) {
+double volumetric_modulus(FemLaw law, const TetMaterial& m) {
   return law == FemLaw::Corotational ? m.lambda : m.lambda + 2.0 * m.mu / 3.0;
 }
 
@@ -80,14 +80,14 @@ namespace {
 Mat3 isochoric_i1_gradient(const ElementState& s) { return s.j23 * (2.0 * s.F - (2.0 / 3.0) * s.i1 * s.F_inverse_t); }
 }  // namespace
 
-double deviatoric_energy_density(const ElementState& s, const Lame& m) {
+double deviatoric_energy_density(const ElementState& s, const TetMaterial& m) {
   if (s.law == FemLaw::Corotational) return m.mu * (s.F - s.R).squaredNorm();
   if (!s.valid) return INFINITY;
   const double bar_i1_minus_3 = s.j23 * s.i1 - 3.0;
   return m.mu * (s.b > 0.0 ? std::expm1(s.b * bar_i1_minus_3) / (2.0 * s.b) : 0.5 * bar_i1_minus_3);
 }
 
-Mat3 deviatoric_piola(const ElementState& s, const Lame& m) {
+Mat3 deviatoric_piola(const ElementState& s, const TetMaterial& m) {
   if (s.law == FemLaw::Corotational) return 2.0 * m.mu * (s.F - s.R);
   if (!s.valid) return Mat3::Constant(NAN);
   return 0.5 * m.mu * s.exponential * isochoric_i1_gradient(s);
@@ -105,7 +105,7 @@ Mat3 corotational_drotation(const ElementState& s, const Mat3& dF) {
 }
 }  // namespace
 
-Mat3 deviatoric_dpiola(const ElementState& s, const Mat3& dF, const Lame& m) {
+Mat3 deviatoric_dpiola(const ElementState& s, const Mat3& dF, const TetMaterial& m) {
   if (s.law == FemLaw::Corotational) return 2.0 * m.mu * (dF - corotational_drotation(s, dF));
   // δ(F⁻ᵀ) = −F⁻ᵀ δFᵀ F⁻ᵀ, δJ^{−2/3} = −⅔ J^{−2/3} F⁻ᵀ:δF, δI₁ = 2F:δF, δe^{b(Ī₁−3)} = b e^{b(Ī₁−3)} δĪ₁.
   const Mat3 g = isochoric_i1_gradient(s);
@@ -123,15 +123,15 @@ Mat3 dilatation_dgradient(const ElementState& s, const Mat3& dF) {
   return -s.F_inverse_t * dF.transpose() * s.F_inverse_t;
 }
 
-double energy_density(const ElementState& s, const Lame& m) {
+double energy_density(const ElementState& s, const TetMaterial& m) {
   return deviatoric_energy_density(s, m) + 0.5 * volumetric_modulus(s.law, m) * s.e * s.e;
 }
 
-Mat3 piola(const ElementState& s, const Lame& m) {
+Mat3 piola(const ElementState& s, const TetMaterial& m) {
   return deviatoric_piola(s, m) + volumetric_modulus(s.law, m) * s.e * dilatation_gradient(s);
 }
 
-Mat3 dpiola(const ElementState& s, const Mat3& dF, const Lame& m) {
+Mat3 dpiola(const ElementState& s, const Mat3& dF, const TetMaterial& m) {
   const Mat3 G = dilatation_gradient(s);
   return deviatoric_dpiola(s, dF, m) +
          volumetric_modulus(s.law, m) * (G.cwiseProduct(dF).sum() * G + s.e * dilatation_dgradient(s, dF));

@@ -31,9 +31,9 @@ namespace pneumo {
 enum class FemLaw : uint8_t { Corotational, NeoHookean };
 
 /// Lamé's parameters from Young's modulus and Poisson's ratio: μ = E/(2(1+ν)), λ = Eν/((1+ν)(1−2ν)).
-struct Lame {
+struct TetMaterial {
   double mu = 0, lambda = 0;
-  static Lame from_young_poisson(double young_pa, double poisson) {
+  static TetMaterial from_young_poisson(double young_pa, double poisson) {
     return {young_pa / (2.0 * (1.0 + poisson)), young_pa * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson))};
   }
 };
@@ -63,18 +63,18 @@ struct ElementState {
 ElementState element_state(FemLaw law, const Mat3& F, double stiffening_b = 0.0);
 
 /// κ of the volumetric energy ½κe²: λ (co-rotational) or the bulk modulus λ + ⅔μ (neo-Hookean).
-double volumetric_modulus(FemLaw law, const Lame& m);
-double deviatoric_energy_density(const ElementState& s, const Lame& m);   // +∞ when !valid
-Mat3 deviatoric_piola(const ElementState& s, const Lame& m);
-Mat3 deviatoric_dpiola(const ElementState& s, const Mat3& dF, const Lame& m);
+double volumetric_modulus(FemLaw law, const TetMaterial& m);
+double deviatoric_energy_density(const ElementState& s, const TetMaterial& m);   // +∞ when !valid
+Mat3 deviatoric_piola(const ElementState& s, const TetMaterial& m);
+Mat3 deviatoric_dpiola(const ElementState& s, const Mat3& dF, const TetMaterial& m);
 /// G = ∂e/∂F and δG for δF.
 Mat3 dilatation_gradient(const ElementState& s);
 Mat3 dilatation_dgradient(const ElementState& s, const Mat3& dF);
 
 /// The whole law on one element (no averaging): ψ, P and δP.
-double energy_density(const ElementState& s, const Lame& m);
-Mat3 piola(const ElementState& s, const Lame& m);
-Mat3 dpiola(const ElementState& s, const Mat3& dF, const Lame& m);
+double energy_density(const ElementState& s, const TetMaterial& m);
+Mat3 piola(const ElementState& s, const TetMaterial& m);
+Mat3 dpiola(const ElementState& s, const Mat3& dF, const TetMaterial& m);
 
 /// A tetrahedron's rest data: D_m⁻¹ and volume (m³) from its four rest vertices.
 struct TetRest {

@@ -53,7 +53,7 @@ class FemForceField final : public ForceField {
 #pragma omp parallel for schedule(static) if (T > 20000)
     for (int64_t t = 0; t < T; ++t) {
       const ElementState& s = state_[t];
-      const Mat3 P = deviatoric_piola(s, tets_.lame[t]) + tets_.kappa[t] * ebar_[groups_->group_of_tet[t]] * dilatation_gradient(s);
+      const Mat3 P = deviatoric_piola(s, tets_.material[t]) + tets_.kappa[t] * ebar_[groups_->group_of_tet[t]] * dilatation_gradient(s);
       const auto fe = nodal_forces(P, tets_.rest[t]);
       for (int i = 0; i < 4; ++i) tet_f_[4 * t + i] = fe[i];
     }
@@ -79,7 +79,7 @@ class FemForceField final : public ForceField {
   double elastic_energy(const ForceModel& model, const std::vector<Vec3>& x) override {
     update_states(model, x);
     double e = 0.0;
-    for (std::size_t t = 0; t < m_.tets.size(); ++t) e += tets_.rest[t].volume_m3 * deviatoric_energy_density(state_[t], tets_.lame[t]);
+    for (std::size_t t = 0; t < m_.tets.size(); ++t) e += tets_.rest[t].volume_m3 * deviatoric_energy_density(state_[t], tets_.material[t]);
     for (std::size_t g = 0; g < ebar_.size(); ++g) e += 0.5 * groups_->weight[g] * ebar_[g] * ebar_[g];
     return e;
   }
@@ -118,7 +118,7 @@ class FemForceField final : public ForceField {
     for (int64_t t = 0; t < T; ++t) {
       const ElementState& s = state_[t];
       const int32_t g = groups_->group_of_tet[t];
-      const Mat3 dP = deviatoric_dpiola(s, dF_[t], tets_.lame[t]) +
+      const Mat3 dP = deviatoric_dpiola(s, dF_[t], tets_.material[t]) +
                       tets_.kappa[t] * (debar_[g] * dilatation_gradient(s) + ebar_[g] * dilatation_dgradient(s, dF_[t]));
       const auto fe = nodal_forces(dP, tets_.rest[t]);   // −V₀ δP D_m⁻ᵀ: the forces' change, −K p
       for (int i = 0; i < 4; ++i) tet_f_[4 * t + i] = -fe[i];
@@ -147,7 +147,7 @@ class FemForceField final : public ForceField {
         for (int i = 0; i < 4; ++i)
           for (int a = 0; a < 3; ++a) {
             const Mat3 dF = Vec3::Unit(a) * grads[i].transpose();
-            chunk[std::size_t(c)][i].col(a) = tets_.rest[t].volume_m3 * dpiola(state_[t], dF, tets_.lame[t]) * grads[i];
+            chunk[std::size_t(c)][i].col(a) = tets_.rest[t].volume_m3 * dpiola(state_[t], dF, tets_.material[t]) * grads[i];
           }
       }
       for (int64_t c = 0; c < n; ++c)
@@ -169,7 +169,7 @@ class FemForceField final : public ForceField {
       rows[t].fill(0.0);
       for (int j = 0; j < 4; ++j)
         for (int b = 0; b < 3; ++b) {
-          const Mat3 dP = dpiola(rest, Vec3::Unit(b) * grads[j].transpose(), tets_.lame[t]);
+          const Mat3 dP = dpiola(rest, Vec3::Unit(b) * grads[j].transpose(), tets_.material[t]);
           for (int i = 0; i < 4; ++i) {
             const Vec3 col = tets_.rest[t].volume_m3 * dP * grads[i];
             for (int a = 0; a < 3; ++a) rows[t][3 * i + a] += std::abs(col[a]);

@@ -36,7 +36,7 @@ class ClFemForceField final : public ForceField {
       const auto& q = m.tets[t];
       tets[t] = {{q[0], q[1], q[2], q[3]}};
       for (int i = 0; i < 9; ++i) dm_inv[9 * t + i] = float(tets_.rest[t].dm_inverse(i / 3, i % 3));
-      consts[t] = {{float(tets_.rest[t].volume_m3), float(tets_.lame[t].mu), float(tets_.kappa[t]), 0.0f}};
+      consts[t] = {{float(tets_.rest[t].volume_m3), float(tets_.material[t].mu), float(tets_.kappa[t]), 0.0f}};
       weight[t] = float(tets_.kappa[t] * tets_.rest[t].volume_m3);
     }
     tets_buf_ = ocl::upload(ctx, tets);

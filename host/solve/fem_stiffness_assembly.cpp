@@ -90,7 +90,7 @@ void FemStiffnessAssembly::assemble(const FemTets& tets, const FemGroups& groups
           const int64_t lj = local_[4 * t + j];
           for (int axis = 0; axis < 3; ++axis) {
             const Mat3 dF = Vec3::Unit(axis) * grad[j].transpose();
-            const Mat3 dP = deviatoric_dpiola(s, dF, tets.lame[t]) + kappa * ebar[g] * dilatation_dgradient(s, dF);
+            const Mat3 dP = deviatoric_dpiola(s, dF, tets.material[t]) + kappa * ebar[g] * dilatation_dgradient(s, dF);
             for (int i = 0; i < 4; ++i) out[local_[4 * t + i] * n + lj].col(axis) += volume * dP * grad[i];
           }
         }

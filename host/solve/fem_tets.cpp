@@ -10,14 +10,14 @@ FemLaw fem_law_of(MaterialModel m) { return m == MaterialModel::FemNeoHookean ? 
 FemTets::FemTets(const Mesh& m, FemLaw l) : law(l) {
   const int64_t T = int64_t(m.tets.size());
   rest.resize(T);
-  lame.resize(T);
+  material.resize(T);
   kappa.resize(T);
   for (int64_t t = 0; t < T; ++t) {
     const auto& q = m.tets[t];
     rest[t] = tet_rest(m.rest_m[q[0]], m.rest_m[q[1]], m.rest_m[q[2]], m.rest_m[q[3]]);
     const double nu = m.tet_poisson.empty() ? 0.25 : m.tet_poisson[t];
-    lame[t] = Lame::from_young_poisson(m.tet_young_pa[t], nu);
-    kappa[t] = volumetric_modulus(law, lame[t]);
+    material[t] = TetMaterial::from_young_poisson(m.tet_young_pa[t], nu);
+    kappa[t] = volumetric_modulus(law, material[t]);
   }
 }
 

@@ -14,7 +14,7 @@ namespace pneumo {
 struct FemTets {
   FemLaw law = FemLaw::Corotational;
   std::vector<TetRest> rest;
-  std::vector<Lame> lame;
+  std::vector<TetMaterial> material;
   std::vector<double> kappa;   // the law's volumetric modulus (fem_element.h)
   FemTets(const Mesh& m, FemLaw law);
 };
