@@ -8,8 +8,8 @@
 // decomposition diagonalises C − I = H + Hᵀ + HᵀH (not C), and the neo-Hookean J − 1 and Ī₁ − 3 are
 // expanded in H, so small strains keep their relative precision instead of drowning in the 1 of I.
 //
-// Layout per tetrahedron: D_m⁻¹ (9 floats, row-major), (V₀, μ, κ, 0) as a float4; the state (kStateFloats,
-// below). Per group of the mean dilatation: [begin, end) in the group's list of tetrahedra and
+// Layout per tetrahedron: D_m⁻¹ (9 floats, row-major), (V₀, μ, κ, k₂) as a float4, the fibre family
+// (a₀, k₁) as a float4 (k₁ = 0: none); the state (kStateFloats, below). Per group of the mean dilatation: [begin, end) in the group's list of tetrahedra and
 // 1/Σ κ_t V_t. Per node: compressed rows of (tetrahedron × 8 + vertex), as host/mesh/adjacency.h.
 
 // State offsets: F (9), A (9: R, or F⁻ᵀ), B (9: the co-rotational (tr S·I − S)⁻¹), then e, J^{−2/3},
@@ -178,6 +178,38 @@ inline void neohookean_state(mat3 h, float b, __global float* st) {
 
 inline mat3 rest_inverse(__global const float* dm_inv, int t) { return m_load(dm_inv + 9 * t); }
 
+inline mat3 m_outer(float3 u, float3 v) {   // u ⊗ v
+  return m_from_cols(u * v.x, u * v.y, u * v.z);
+}
+
+// The fibres' ψ_f, ψ' and ψ'' at F (fem_element.h; all zero in compression or without fibres), for
+// fib = (a₀, k₁); *fa = F a₀. I₄ − 1 from F a₀ − a₀, so a small stretch keeps its relative precision.
+inline float3 fibre_terms(mat3 F, float4 fib, float k2, float3* fa) {
+  *fa = m_vec(F, fib.xyz);
+  if (!(fib.w > 0.0f)) return (float3)(0.0f);
+  const float3 h = *fa - fib.xyz;
+  const float e = 2.0f * dot(fib.xyz, h) + dot(h, h);
+  if (e < 0.0f) return (float3)(0.0f);
+  const float x = k2 * e * e, ex = exp(x);
+  const float energy = k2 > 0.0f ? fib.w * expm1(x) / (2.0f * k2) : 0.5f * fib.w * e * e;
+  return (float3)(energy, fib.w * e * ex, fib.w * (1.0f + 2.0f * x) * ex);
+}
+
+// P_f = 2ψ' (F a₀) ⊗ a₀.
+inline mat3 fibre_piola(mat3 F, float4 fib, float k2) {
+  float3 fa;
+  const float3 t = fibre_terms(F, fib, k2, &fa);
+  return m_outer(2.0f * t.y * fa, fib.xyz);
+}
+
+// δP_f = (2ψ' δF a₀ + 4ψ'' ((F a₀)·(δF a₀)) F a₀) ⊗ a₀.
+inline mat3 fibre_dpiola(mat3 F, mat3 dF, float4 fib, float k2) {
+  float3 fa;
+  const float3 t = fibre_terms(F, fib, k2, &fa);
+  const float3 dfa = m_vec(dF, fib.xyz);
+  return m_outer(2.0f * t.y * dfa + 4.0f * t.z * dot(fa, dfa) * fa, fib.xyz);
+}
+
 // D_u of the vertices' displacements (or of a direction p).
 inline mat3 edge_matrix_of(__global const float4* restrict u, int4 q) {
   const float3 a = u[q.x].xyz;
@@ -187,7 +219,8 @@ inline mat3 edge_matrix_of(__global const float4* restrict u, int4 q) {
 // law: 0 co-rotational, 1 neo-Hookean (b = 0) or Demiray (b > 0).
 __kernel void fem_states(__global const float4* restrict u, __global const int4* restrict tets,
                          __global const float* restrict dm_inv, __global const float4* restrict tet_consts,
-                         const int law, const float b, const int n_tets, __global float* restrict state) {
+                         __global const float4* restrict fibre, const int law, const float b, const int n_tets,
+                         __global float* restrict state) {
   const int t = get_global_id(0);
   if (t >= n_tets) return;
   const mat3 h = m_mul(edge_matrix_of(u, tets[t]), rest_inverse(dm_inv, t));
@@ -202,6 +235,8 @@ __kernel void fem_states(__global const float4* restrict u, __global const int4*
     const float x = st[S_PSI];
     st[S_PSI] = tet_consts[t].y * (b > 0.0f ? expm1(b * x) / (2.0f * b) : 0.5f * x);
   }
+  float3 fa;
+  st[S_PSI] += fibre_terms(m_load(st + S_F), fibre[t], tet_consts[t].w, &fa).x;
 }
 
 // Group averages: out[g] = Σ_t w_t q_t / Σ_t w_t over the group's tetrahedra, q_t = per_tet[t * stride + offset].
@@ -269,14 +304,16 @@ inline void store_nodal_forces(mat3 P, mat3 dm_inverse, float volume, __global f
 }
 
 __kernel void fem_forces(__global const float* restrict state, __global const float* restrict dm_inv,
-                         __global const float4* restrict tet_consts, __global const int* restrict group_of_tet,
+                         __global const float4* restrict tet_consts, __global const float4* restrict fibre,
+                         __global const int* restrict group_of_tet,
                          __global const float* restrict ebar, const int law, const int n_tets,
                          __global float4* restrict tet_force) {
   const int t = get_global_id(0);
   if (t >= n_tets) return;
   __global const float* st = state + kStateFloats * t;
-  const float4 c = tet_consts[t];   // V₀, μ, κ
-  const mat3 P = m_axpy(c.z * ebar[group_of_tet[t]], dilatation_gradient(law, st), deviatoric_piola(law, st, c.y));
+  const float4 c = tet_consts[t];   // V₀, μ, κ, k₂
+  const mat3 Pd = m_add(deviatoric_piola(law, st, c.y), fibre_piola(m_load(st + S_F), fibre[t], c.w));
+  const mat3 P = m_axpy(c.z * ebar[group_of_tet[t]], dilatation_gradient(law, st), Pd);
   store_nodal_forces(P, rest_inverse(dm_inv, t), c.x, tet_force + 4 * t);
 }
 
@@ -293,7 +330,8 @@ __kernel void fem_dF(__global const float4* restrict p, __global const int4* res
 
 // −K p per vertex: the nodal forces of δP_t = δP_d + κ(δē G + ē δG).
 __kernel void fem_dforces(__global const float* restrict state, __global const float* restrict dm_inv,
-                          __global const float4* restrict tet_consts, __global const int* restrict group_of_tet,
+                          __global const float4* restrict tet_consts, __global const float4* restrict fibre,
+                          __global const int* restrict group_of_tet,
                           __global const float* restrict ebar, __global const float* restrict debar,
                           __global const float* restrict dF, const int law, const float b, const int n_tets,
                           __global float4* restrict tet_force) {
@@ -303,7 +341,7 @@ __kernel void fem_dforces(__global const float* restrict state, __global const f
   const float4 c = tet_consts[t];
   const int g = group_of_tet[t];
   const mat3 d = m_load(dF + 10 * t);
-  mat3 dP = deviatoric_dpiola(law, st, d, c.y, b);
+  mat3 dP = m_add(deviatoric_dpiola(law, st, d, c.y, b), fibre_dpiola(m_load(st + S_F), d, fibre[t], c.w));
   dP = m_axpy(c.z * debar[g], dilatation_gradient(law, st), dP);
   dP = m_axpy(c.z * ebar[g], dilatation_dgradient(law, st, d), dP);
   store_nodal_forces(m_scale(dP, -1.0f), rest_inverse(dm_inv, t), c.x, tet_force + 4 * t);
@@ -312,7 +350,8 @@ __kernel void fem_dforces(__global const float* restrict state, __global const f
 // K_ii per tetrahedron and vertex from unit moves along each axis, with the tetrahedron's own
 // dilatation (the preconditioner, as fem_force_field.cpp): 4 blocks of 3 columns (float4 each).
 __kernel void fem_diagonal(__global const float* restrict state, __global const float* restrict dm_inv,
-                           __global const float4* restrict tet_consts, const int law, const float b,
+                           __global const float4* restrict tet_consts, __global const float4* restrict fibre,
+                           const int law, const float b,
                            const int n_tets, __global float4* restrict blocks) {
   const int t = get_global_id(0);
   if (t >= n_tets) return;
@@ -328,7 +367,7 @@ __kernel void fem_diagonal(__global const float* restrict state, __global const 
     for (int a = 0; a < 3; ++a) {
       mat3 dF = m_zero();
       dF.m[3 * a + 0] = grads[i].x; dF.m[3 * a + 1] = grads[i].y; dF.m[3 * a + 2] = grads[i].z;
-      mat3 dP = deviatoric_dpiola(law, st, dF, c.y, b);
+      mat3 dP = m_add(deviatoric_dpiola(law, st, dF, c.y, b), fibre_dpiola(m_load(st + S_F), dF, fibre[t], c.w));
       dP = m_axpy(c.z * m_ddot(G, dF), G, dP);
       dP = m_axpy(c.z * e, dilatation_dgradient(law, st, dF), dP);
       blocks[12 * t + 3 * i + a] = (float4)(c.x * m_vec(dP, grads[i]), 0.0f);

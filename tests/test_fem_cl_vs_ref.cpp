@@ -1,7 +1,7 @@
 // The finite elements on OpenCL (kernels/fem_forces.cl, float32) against the double-precision CPU
 // reference (host/solve/fem_force_field.cpp), on every OpenCL device found, on random valid meshes
 // and states (a fixed seed (seed_support.h), printed on failure): random roles, cube sizes, moduli, Poisson
-// ratios up to 0.49, both laws, Demiray's stiffening, with and without the mean dilatation, pressure
+// ratios up to 0.49, both laws, Demiray's stiffening, fibres, with and without the mean dilatation, pressure
 // and gravity, deformations of up to 10 % of a cube with a rotation of up to a radian.
 //
 // Tolerance, per node and axis: 64·ε₃₂·S_i with ε₃₂ = 2⁻²³ and S_i the sum of the magnitudes node i's
@@ -57,6 +57,17 @@ RandomCase random_case(std::mt19937& rng) {
     c.x.push_back(centre + Q * (r - centre) + 0.1 * h * Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5));
     c.dir.push_back(h * Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5));
   }
+  // Fibres (fem_element.h) in about half the cases, in a random direction in each tetrahedron and in
+  // about 2 of 3 tetrahedra, k₁ up to 2μ.
+  if (u(rng) < 0.5) {
+    c.mesh.tet_fibre.resize(c.mesh.tets.size());
+    c.mesh.tet_fibre_k1_pa.resize(c.mesh.tets.size());
+    c.mesh.fibre_k2 = u(rng) < 0.5 ? 0.0 : 5.0 * u(rng);
+    for (std::size_t t = 0; t < c.mesh.tets.size(); ++t) {
+      c.mesh.tet_fibre[t] = Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5).normalized();
+      c.mesh.tet_fibre_k1_pa[t] = u(rng) < 0.67 ? 2.0 * u(rng) * c.mesh.tet_young_pa[t] / (2.0 * (1.0 + c.mesh.tet_poisson[t])) : 0.0;
+    }
+  }
   c.model.material = u(rng) < 0.5 ? MaterialModel::FemCorotational : MaterialModel::FemNeoHookean;
   c.model.mean_dilatation = u(rng) < 0.7;
   c.model.stiffening = c.model.material == MaterialModel::FemNeoHookean && u(rng) < 0.5 ? 10.0 * u(rng) : 0.0;
@@ -78,7 +89,8 @@ std::vector<double> scales(const RandomCase& c, const std::vector<Vec3>& y, bool
     const Mat3 D = edge_matrix(y[q[0]], y[q[1]], y[q[2]], y[q[3]]) * rest.dm_inverse;
     const double h = product ? D.norm() : (D - Mat3::Identity()).norm() + 1.0;
     const TetMaterial l = TetMaterial::from_young_poisson(m.tet_young_pa[t], m.tet_poisson[t]);
-    const double k = l.lambda + l.mu;
+    // The fibres' k₁ (≤ 2μ; fem_element.h) adds at most 4k₁(1 + |H|)² ≤ 8μ(1 + |H|)² at these strains.
+    const double k = l.lambda + l.mu + (m.tet_fibre_k1_pa.empty() ? 0.0 : 3.0 * m.tet_fibre_k1_pa[t]);
     const Mat3& Di = rest.dm_inverse;
     const Vec3 grads[4] = {-(Di.row(0) + Di.row(1) + Di.row(2)).transpose(), Di.row(0).transpose(),
                            Di.row(1).transpose(), Di.row(2).transpose()};
@@ -119,7 +131,7 @@ TEST_P(FemClVsRef, RandomMeshesAndStatesMatchTheReference) {
     SCOPED_TRACE("trial " + std::to_string(trial));
     const RandomCase c = random_case(rng);
     SCOPED_TRACE(std::string(enum_name(c.model.material)) + (c.model.mean_dilatation ? ", mean dilatation" : "") +
-                 ", b " + std::to_string(c.model.stiffening));
+                 ", b " + std::to_string(c.model.stiffening) + (c.mesh.tet_fibre.empty() ? "" : ", fibres"));
     auto ref = make_force_field(c.mesh, c.model);
     auto dev = make_fem_force_field_cl(*ctx, c.mesh, c.model.material);
     std::vector<Vec3> fr, fd, kr, kd;

@@ -149,6 +149,11 @@ struct Mesh {
   std::vector<double> tet_rest_volume_m3;
   std::vector<double> tet_young_pa;         // Hill's mean over its tissue × the tissue's share, floored
   std::vector<double> tet_poisson;          // ν of the finite elements (empty: 1/4, the springs' own)
+  // The finite elements' fibre family (solve/fem_element.h; mesh/wall_fibres.h): each tetrahedron's unit
+  // rest direction a₀ and k₁ (Pa; 0 or empty: none), and the one k₂. The springs ignore them.
+  std::vector<Vec3> tet_fibre;
+  std::vector<double> tet_fibre_k1_pa;
+  double fibre_k2 = 0;
   std::vector<std::array<int32_t, 6>> tet_springs;   // spring of each local edge (kTetEdges order)
 
   // Springs (one per unique tetrahedron edge, per part).

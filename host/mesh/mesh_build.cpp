@@ -613,7 +613,7 @@ uint64_t mesh_bytes(const Mesh& m) {
   const ContactFaces& c = m.contact;
   return held(m.rest_m) + held(m.node_part) + held(m.hold) + held(m.node_lattice) + held(m.node_attached) + held(m.mass_kg) + held(m.tets) +
          held(m.tet_part) + held(m.tet_label) + held(m.tet_fraction) + held(m.tet_cube) + held(m.tet_rest_volume_m3) +
-         held(m.tet_young_pa) + held(m.tet_poisson) + held(m.tet_springs) + held(m.springs) + held(m.spring_rest_m) +
+         held(m.tet_young_pa) + held(m.tet_poisson) + held(m.tet_fibre) + held(m.tet_fibre_k1_pa) + held(m.tet_springs) + held(m.springs) + held(m.spring_rest_m) +
          held(m.spring_k) + held(m.spring_c) + held(m.load_tet) + held(m.load_c) + held(c.tet) + held(c.w) + held(c.c) +
          held(c.part) + held(c.fixed_centre_m) + held(c.fixed_area_m2);
 }

@@ -80,17 +80,56 @@ namespace {
 Mat3 isochoric_i1_gradient(const ElementState& s) { return s.j23 * (2.0 * s.F - (2.0 / 3.0) * s.i1 * s.F_inverse_t); }
 }  // namespace
 
+namespace {
+
+// The fibres' ψ_f, ψ' and ψ'' at I₄ (fem_element.h); all zero in compression (I₄ < 1) or without fibres.
+struct FibreTerms {
+  double energy = 0, d1 = 0, d2 = 0;
+  Vec3 fa;   // F a₀
+};
+FibreTerms fibre_terms(const ElementState& s, const TetMaterial& m) {
+  FibreTerms f;
+  if (!(m.fibre_k1_pa > 0.0)) return f;
+  f.fa = s.F * m.fibre;
+  const double e = f.fa.squaredNorm() - 1.0;
+  if (e < 0.0) return f;
+  const double k1 = m.fibre_k1_pa, k2 = m.fibre_k2, x = k2 * e * e;
+  const double ex = std::exp(x);
+  f.energy = k2 > 0.0 ? k1 * std::expm1(x) / (2.0 * k2) : 0.5 * k1 * e * e;
+  f.d1 = k1 * e * ex;
+  f.d2 = k1 * (1.0 + 2.0 * x) * ex;
+  return f;
+}
+
+double fibre_energy_density(const ElementState& s, const TetMaterial& m) { return fibre_terms(s, m).energy; }
+
+Mat3 fibre_piola(const ElementState& s, const TetMaterial& m) {
+  const FibreTerms f = fibre_terms(s, m);
+  if (f.d1 == 0.0) return Mat3::Zero();
+  return 2.0 * f.d1 * f.fa * m.fibre.transpose();
+}
+
+Mat3 fibre_dpiola(const ElementState& s, const Mat3& dF, const TetMaterial& m) {
+  const FibreTerms f = fibre_terms(s, m);
+  if (f.d2 == 0.0) return Mat3::Zero();
+  const Vec3 dfa = dF * m.fibre;
+  return (2.0 * f.d1 * dfa + 4.0 * f.d2 * f.fa.dot(dfa) * f.fa) * m.fibre.transpose();
+}
+
+}  // namespace
+
 double deviatoric_energy_density(const ElementState& s, const TetMaterial& m) {
-  if (s.law == FemLaw::Corotational) return m.mu * (s.F - s.R).squaredNorm();
+  if (s.law == FemLaw::Corotational) return m.mu * (s.F - s.R).squaredNorm() + fibre_energy_density(s, m);
   if (!s.valid) return INFINITY;
   const double bar_i1_minus_3 = s.j23 * s.i1 - 3.0;
-  return m.mu * (s.b > 0.0 ? std::expm1(s.b * bar_i1_minus_3) / (2.0 * s.b) : 0.5 * bar_i1_minus_3);
+  return m.mu * (s.b > 0.0 ? std::expm1(s.b * bar_i1_minus_3) / (2.0 * s.b) : 0.5 * bar_i1_minus_3) +
+         fibre_energy_density(s, m);
 }
 
 Mat3 deviatoric_piola(const ElementState& s, const TetMaterial& m) {
-  if (s.law == FemLaw::Corotational) return 2.0 * m.mu * (s.F - s.R);
+  if (s.law == FemLaw::Corotational) return 2.0 * m.mu * (s.F - s.R) + fibre_piola(s, m);
   if (!s.valid) return Mat3::Constant(NAN);
-  return 0.5 * m.mu * s.exponential * isochoric_i1_gradient(s);
+  return 0.5 * m.mu * s.exponential * isochoric_i1_gradient(s) + fibre_piola(s, m);
 }
 
 Mat3 dilatation_gradient(const ElementState& s) {
@@ -106,7 +145,7 @@ Mat3 corotational_drotation(const ElementState& s, const Mat3& dF) {
 }  // namespace
 
 Mat3 deviatoric_dpiola(const ElementState& s, const Mat3& dF, const TetMaterial& m) {
-  if (s.law == FemLaw::Corotational) return 2.0 * m.mu * (dF - corotational_drotation(s, dF));
+  if (s.law == FemLaw::Corotational) return 2.0 * m.mu * (dF - corotational_drotation(s, dF)) + fibre_dpiola(s, dF, m);
   // δ(F⁻ᵀ) = −F⁻ᵀ δFᵀ F⁻ᵀ, δJ^{−2/3} = −⅔ J^{−2/3} F⁻ᵀ:δF, δI₁ = 2F:δF, δe^{b(Ī₁−3)} = b e^{b(Ī₁−3)} δĪ₁.
   const Mat3 g = isochoric_i1_gradient(s);
   const Mat3 d_inverse_t = -s.F_inverse_t * dF.transpose() * s.F_inverse_t;
@@ -115,7 +154,7 @@ Mat3 deviatoric_dpiola(const ElementState& s, const Mat3& dF, const TetMaterial&
   const Mat3 dg = d_j23 / s.j23 * g +
                   s.j23 * (2.0 * dF - (2.0 / 3.0) * (d_i1 * s.F_inverse_t + s.i1 * d_inverse_t));
   const double d_exponential = s.b * s.exponential * g.cwiseProduct(dF).sum();
-  return 0.5 * m.mu * (d_exponential * g + s.exponential * dg);
+  return 0.5 * m.mu * (d_exponential * g + s.exponential * dg) + fibre_dpiola(s, dF, m);
 }
 
 Mat3 dilatation_dgradient(const ElementState& s, const Mat3& dF) {

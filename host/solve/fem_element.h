@@ -21,6 +21,19 @@
 // The isochoric invariant keeps the small-strain bulk modulus κ whatever b (with I₁ itself, b would
 // add 2bμ to it). J ≤ 0 has no energy (the element is inverted): the caller treats it as such.
 // Both laws reduce to Hooke's law with Lamé's μ and λ at small strain.
+//
+// Either law may carry one family of collagen fibres along the unit rest direction a₀, in the
+// Holzapfel–Gasser–Ogden form (Holzapfel, Gasser & Ogden 2000, J Elasticity 61:1) with the full
+// fourth invariant I₄ = a₀·C a₀ = |F a₀|², not its isochoric part: Nolan et al. 2014 (J Mech Behav
+// Biomed Mater 39:48) show that the isochoric Ī₄ leaves a compressible fibre-reinforced material without
+// any response to a stretch along its fibres at constant volume. It adds to the deviatoric part
+// (it is no measure of dilatation, so the mean dilatation leaves it alone):
+//   ψ_f = k₁/(2k₂) (e^{k₂(I₄−1)²} − 1)   (k₁/2 (I₄−1)² at k₂ = 0), for I₄ ≥ 1 only: fibres carry no compression,
+//   P_f = 2ψ'(I₄) (F a₀) ⊗ a₀,   ψ' = k₁ (I₄−1) e^{k₂(I₄−1)²},
+//   δP_f = 2ψ' (δF a₀) ⊗ a₀ + 4ψ'' ((F a₀)·(δF a₀)) (F a₀) ⊗ a₀,   ψ'' = k₁ (1 + 2k₂(I₄−1)²) e^{k₂(I₄−1)²}.
+// At rest (I₄ = 1) the stiffness is the tension side's, as for the contact's kink (contact.h), so a
+// Newton step from rest sees the fibres it will stretch. At small strain the fibres add 4k₁ ε_aa² to
+// the energy: a uniaxial stretch along them at constant volume meets E = 3μ + 4k₁, across them 3μ.
 #include <array>
 #include <cstdint>
 
@@ -30,9 +43,13 @@ namespace pneumo {
 
 enum class FemLaw : uint8_t { Corotational, NeoHookean };
 
-/// Lamé's parameters from Young's modulus and Poisson's ratio: μ = E/(2(1+ν)), λ = Eν/((1+ν)(1−2ν)).
+/// One tetrahedron's material: Lamé's parameters and its fibre family (none where fibre_k1_pa is 0).
 struct TetMaterial {
   double mu = 0, lambda = 0;
+  Vec3 fibre = Vec3::Zero();   // a₀, the fibres' unit direction at rest
+  double fibre_k1_pa = 0;      // k₁ of ψ_f
+  double fibre_k2 = 0;         // k₂ of ψ_f (dimensionless)
+  /// Lamé's parameters from Young's modulus and Poisson's ratio: μ = E/(2(1+ν)), λ = Eν/((1+ν)(1−2ν)).
   static TetMaterial from_young_poisson(double young_pa, double poisson) {
     return {young_pa / (2.0 * (1.0 + poisson)), young_pa * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson))};
   }

@@ -31,17 +31,20 @@ class ClFemForceField final : public ForceField {
     const Adjacency adj = Adjacency::of(m);
     std::vector<cl_int4> tets(std::max<int64_t>(T_, 1), cl_int4{{0, 0, 0, 0}});
     std::vector<float> dm_inv(9 * tets.size(), 0.0f), weight(tets.size(), 0.0f);
-    std::vector<cl_float4> consts(tets.size(), cl_float4{{0, 0, 0, 0}});
+    std::vector<cl_float4> consts(tets.size(), cl_float4{{0, 0, 0, 0}}), fibre(tets.size(), cl_float4{{0, 0, 0, 0}});
     for (int64_t t = 0; t < T_; ++t) {
       const auto& q = m.tets[t];
       tets[t] = {{q[0], q[1], q[2], q[3]}};
       for (int i = 0; i < 9; ++i) dm_inv[9 * t + i] = float(tets_.rest[t].dm_inverse(i / 3, i % 3));
-      consts[t] = {{float(tets_.rest[t].volume_m3), float(tets_.material[t].mu), float(tets_.kappa[t]), 0.0f}};
+      const TetMaterial& mt = tets_.material[t];
+      consts[t] = {{float(tets_.rest[t].volume_m3), float(mt.mu), float(tets_.kappa[t]), float(mt.fibre_k2)}};
+      fibre[t] = {{float(mt.fibre[0]), float(mt.fibre[1]), float(mt.fibre[2]), float(mt.fibre_k1_pa)}};
       weight[t] = float(tets_.kappa[t] * tets_.rest[t].volume_m3);
     }
     tets_buf_ = ocl::upload(ctx, tets);
     dm_inv_ = ocl::upload(ctx, dm_inv);
     consts_ = ocl::upload(ctx, consts);
+    fibre_ = ocl::upload(ctx, fibre);
     weight_ = ocl::upload(ctx, weight);
     tet_start_ = ocl::upload(ctx, adj.tets.start);
     tet_item_ = ocl::upload(ctx, adj.tets.item);
@@ -87,7 +90,7 @@ class ClFemForceField final : public ForceField {
     update_states(model, x);
     auto& q = ctx_.queue();
     if (T_ > 0) {
-      ocl::set_args(k_forces_, state_, dm_inv_, consts_, group_of_tet_, ebar_, law_int(), cl_int(T_), tet_force_);
+      ocl::set_args(k_forces_, state_, dm_inv_, consts_, fibre_, group_of_tet_, ebar_, law_int(), cl_int(T_), tet_force_);
       q.enqueueNDRangeKernel(k_forces_, cl::NullRange, cl::NDRange(ocl::global_size(T_)), cl::NDRange(kLocal));
     }
     const bool loads = model.pressure_pa != 0.0 && R_ > 0;
@@ -137,7 +140,7 @@ class ClFemForceField final : public ForceField {
       ocl::set_args(k_dF_, p, tets_buf_, dm_inv_, state_, law_int(), cl_int(T_), dF_);
       q.enqueueNDRangeKernel(k_dF_, cl::NullRange, cl::NDRange(ocl::global_size(T_)), cl::NDRange(kLocal));
       average(dF_, 10, 9, debar_);
-      ocl::set_args(k_dforces_, state_, dm_inv_, consts_, group_of_tet_, ebar_, debar_, dF_, law_int(), float(b_),
+      ocl::set_args(k_dforces_, state_, dm_inv_, consts_, fibre_, group_of_tet_, ebar_, debar_, dF_, law_int(), float(b_),
                     cl_int(T_), tet_force_);
       q.enqueueNDRangeKernel(k_dforces_, cl::NullRange, cl::NDRange(ocl::global_size(T_)), cl::NDRange(kLocal));
     }
@@ -149,7 +152,7 @@ class ClFemForceField final : public ForceField {
   void stiffness_diagonal(std::vector<Mat3>& blocks) override {
     auto& q = ctx_.queue();
     if (T_ > 0) {
-      ocl::set_args(k_diagonal_, state_, dm_inv_, consts_, law_int(), float(b_), cl_int(T_), blocks_);
+      ocl::set_args(k_diagonal_, state_, dm_inv_, consts_, fibre_, law_int(), float(b_), cl_int(T_), blocks_);
       q.enqueueNDRangeKernel(k_diagonal_, cl::NullRange, cl::NDRange(ocl::global_size(T_)), cl::NDRange(kLocal));
     }
     ocl::set_args(k_gather_diagonal_, blocks_, tet_start_, tet_item_, cl_int(N_), node_blocks_);
@@ -214,7 +217,7 @@ class ClFemForceField final : public ForceField {
     auto& q = ctx_.queue();
     q.enqueueWriteBuffer(u_, CL_TRUE, 0, N_ * sizeof(cl_float4), to_float4(u).data());
     if (T_ > 0) {
-      ocl::set_args(k_states_, u_, tets_buf_, dm_inv_, consts_, law_int(), float(b_), cl_int(T_), state_);
+      ocl::set_args(k_states_, u_, tets_buf_, dm_inv_, consts_, fibre_, law_int(), float(b_), cl_int(T_), state_);
       q.enqueueNDRangeKernel(k_states_, cl::NullRange, cl::NDRange(ocl::global_size(T_)), cl::NDRange(kLocal));
       average(state_, kStateFloats, kStateE, ebar_);
     }
@@ -226,7 +229,7 @@ class ClFemForceField final : public ForceField {
   FemTets tets_;
   std::optional<FemGroups> groups_;
   int64_t N_, T_, R_;
-  cl::Buffer tets_buf_, dm_inv_, consts_, weight_, tet_start_, tet_item_, load_start_, load_item_, load_nodes_,
+  cl::Buffer tets_buf_, dm_inv_, consts_, fibre_, weight_, tet_start_, tet_item_, load_start_, load_item_, load_nodes_,
       load_c_, mass_, rest_x_, u_, p_, f_, state_, tet_force_, load_force_, dF_, blocks_, node_blocks_;
   cl::Buffer group_of_tet_, group_tets_, group_begin_, inv_weight_, ebar_, debar_;
   cl::Kernel k_states_, k_average_, k_forces_, k_dF_, k_dforces_, k_diagonal_, k_gather_, k_gather_diagonal_, k_load_;
@@ -241,10 +244,10 @@ uint64_t fem_force_field_cl_bytes(const Mesh& m) {
   const uint64_t N = uint64_t(m.node_count()), T = uint64_t(m.tets.size()), R = uint64_t(m.load_tet.size());
   const Adjacency adj = Adjacency::of(m);
   const uint64_t csr = 8 * 2 * (N + 1) + 4 * (adj.tets.item.size() + adj.loads.item.size());
-  // Per tetrahedron: nodes 16, D_m⁻¹ 36, constants 16, weight 4, state 160, 4 forces 64, δF 40,
+  // Per tetrahedron: nodes 16, D_m⁻¹ 36, constants 16, fibre 16, weight 4, state 160, 4 forces 64, δF 40,
   // diagonal blocks 192, group index and list 8, and up to one group each (ē, δē, 1/Σw, begin: 16).
   // Per node: 5 float4 vectors and 3 for its diagonal block, mass. Per load: nodes 16, c 64, forces 64.
-  return T * (16 + 36 + 16 + 4 + 160 + 64 + 40 + 192 + 8 + 16) + N * (8 * 16 + 4) + R * (16 + 64 + 64) + csr;
+  return T * (16 + 36 + 16 + 16 + 4 + 160 + 64 + 40 + 192 + 8 + 16) + N * (8 * 16 + 4) + R * (16 + 64 + 64) + csr;
 }
 
 std::unique_ptr<ForceField> make_fem_force_field_cl(ocl::Context& ctx, const Mesh& m, MaterialModel model) {

@@ -17,6 +17,11 @@ FemTets::FemTets(const Mesh& m, FemLaw l) : law(l) {
     rest[t] = tet_rest(m.rest_m[q[0]], m.rest_m[q[1]], m.rest_m[q[2]], m.rest_m[q[3]]);
     const double nu = m.tet_poisson.empty() ? 0.25 : m.tet_poisson[t];
     material[t] = TetMaterial::from_young_poisson(m.tet_young_pa[t], nu);
+    if (!m.tet_fibre_k1_pa.empty() && m.tet_fibre_k1_pa[t] > 0.0) {
+      material[t].fibre = m.tet_fibre[t];
+      material[t].fibre_k1_pa = m.tet_fibre_k1_pa[t];
+      material[t].fibre_k2 = m.fibre_k2;
+    }
     kappa[t] = volumetric_modulus(law, material[t]);
   }
 }

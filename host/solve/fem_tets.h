@@ -14,7 +14,7 @@ namespace pneumo {
 struct FemTets {
   FemLaw law = FemLaw::Corotational;
   std::vector<TetRest> rest;
-  std::vector<TetMaterial> material;
+  std::vector<TetMaterial> material;   // μ, λ and the fibre family (fem_element.h)
   std::vector<double> kappa;   // the law's volumetric modulus (fem_element.h)
   FemTets(const Mesh& m, FemLaw law);
 };

@@ -1,0 +1,147 @@
+// The fibre term of the finite elements (solve/fem_element.h) and the wall's fibre directions
+// (mesh/wall_fibres.h) against truths computed here: the stress is the energy's gradient and its
+// derivative the stress's finite difference with fibres in tension, fibres carry nothing in
+// compression or under a rotation, and a uniaxial stretch along and across them follows the closed form
+// of an incompressible neo-Hookean matrix with fibres.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "solve/fem_element.h"
+
+namespace pneumo {
+namespace {
+
+const uint32_t kSeed = 20261207u;
+
+TetMaterial with_fibre(TetMaterial m, const Vec3& a, double k1_over_mu, double k2) {
+  m.fibre = a.normalized();
+  m.fibre_k1_pa = k1_over_mu * m.mu;
+  m.fibre_k2 = k2;
+  return m;
+}
+
+Mat3 random_matrix(std::mt19937& rng, double amplitude) {
+  std::uniform_real_distribution<double> u(-amplitude, amplitude);
+  Mat3 m;
+  for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = u(rng);
+  return m;
+}
+
+struct Case {
+  FemLaw law;
+  double b, k2;
+  const char* name;
+};
+const Case kCases[] = {{FemLaw::Corotational, 0.0, 0.0, "corotational, quadratic fibres"},
+                       {FemLaw::NeoHookean, 0.0, 0.0, "neo-Hookean, quadratic fibres"},
+                       {FemLaw::NeoHookean, 4.0, 3.0, "Demiray b=4, exponential fibres k2=3"}};
+
+TEST(FemFibres, StressIsTheGradientOfTheEnergyAndItsDerivativeTheStresssDifference) {
+  // Compared: P(F) against central differences of ψ (h = 1e-6), and δP against central differences of P,
+  // at random F of strains up to 30 % about a random fibre; samples whose fibre lies within 1e-4 of
+  // I₄ = 1 are skipped (the tension switch's kink). Tolerance 1e-6 relative: O(h²) and rounding.
+  std::mt19937 rng(kSeed);
+  const TetMaterial matrix = TetMaterial::from_young_poisson(60e3, 0.45);
+  int tension = 0, compression = 0;
+  for (const Case& c : kCases)
+    for (int k = 0; k < 24; ++k) {
+      SCOPED_TRACE(std::string(c.name) + " sample " + std::to_string(k));
+      const TetMaterial m = with_fibre(matrix, Vec3(random_matrix(rng, 1.0).col(0)), 0.67 + k % 3, c.k2);
+      const Mat3 F = Mat3::Identity() + random_matrix(rng, 0.3);
+      const double i4 = (F * m.fibre).squaredNorm();
+      if (std::abs(i4 - 1.0) < 1e-4) continue;
+      (i4 > 1.0 ? tension : compression) += 1;
+      const ElementState s = element_state(c.law, F, c.b);
+      const Mat3 P = piola(s, m);
+      Mat3 fd;
+      const double h = 1e-6;
+      for (int i = 0; i < 9; ++i) {
+        Mat3 Fp = F, Fm = F;
+        Fp(i / 3, i % 3) += h;
+        Fm(i / 3, i % 3) -= h;
+        fd(i / 3, i % 3) = (energy_density(element_state(c.law, Fp, c.b), m) -
+                            energy_density(element_state(c.law, Fm, c.b), m)) / (2 * h);
+      }
+      EXPECT_LT((P - fd).norm(), 1e-6 * P.norm());
+      const Mat3 dF = random_matrix(rng, 1.0);
+      const Mat3 dP = dpiola(s, dF, m);
+      const Mat3 dfd = (piola(element_state(c.law, F + h * dF, c.b), m) - piola(element_state(c.law, F - h * dF, c.b), m)) / (2 * h);
+      EXPECT_LT((dP - dfd).norm(), 1e-6 * dP.norm());
+    }
+  EXPECT_GT(tension, 10);       // both branches were sampled
+  EXPECT_GT(compression, 10);
+}
+
+TEST(FemFibres, FibresCarryNothingInCompressionOrUnderARotation) {
+  // Compared: with fibres along x, the stress of F = diag(0.9, 1.05, 1.05) (fibres shortened) and the
+  // energy and stress of a rotation by 2 rad, against the matrix alone. Tolerance 1e-9 of μ: rounding.
+  const TetMaterial matrix = TetMaterial::from_young_poisson(60e3, 0.45);
+  const TetMaterial m = with_fibre(matrix, Vec3::UnitX(), 0.67, 3.0);
+  const Mat3 Q = Eigen::AngleAxisd(2.0, Vec3(1, 2, -0.5).normalized()).toRotationMatrix();
+  for (FemLaw law : {FemLaw::Corotational, FemLaw::NeoHookean}) {
+    const ElementState shortened = element_state(law, Vec3(0.9, 1.05, 1.05).asDiagonal().toDenseMatrix(), 0.0);
+    EXPECT_LT((piola(shortened, m) - piola(shortened, matrix)).norm(), 1e-9 * matrix.mu);
+    const ElementState rotated = element_state(law, Q, 0.0);
+    EXPECT_LT(std::abs(energy_density(rotated, m)), 1e-9 * matrix.mu);
+    EXPECT_LT(piola(rotated, m).norm(), 1e-9 * matrix.mu);
+  }
+}
+
+// The nominal stress P₁₁ of uniaxial stress at stretch λ along x: the lateral stretches found by Newton
+// on P₂₂ = P₃₃ = 0 (F diagonal: P is diagonal for a fibre along a coordinate axis).
+double uniaxial_nominal_stress(const TetMaterial& m, double lambda) {
+  Vec3 s(lambda, 1.0 / std::sqrt(lambda), 1.0 / std::sqrt(lambda));
+  for (int it = 0; it < 60; ++it) {
+    const auto lateral = [&](const Vec3& st) {
+      const Mat3 P = piola(element_state(FemLaw::NeoHookean, st.asDiagonal().toDenseMatrix(), 0.0), m);
+      return Eigen::Vector2d(P(1, 1), P(2, 2));
+    };
+    const Eigen::Vector2d r = lateral(s);
+    if (r.norm() < 1e-10 * m.mu) break;
+    Eigen::Matrix2d J;
+    for (int j = 0; j < 2; ++j) {
+      Vec3 sp = s;
+      sp[1 + j] += 1e-7;
+      J.col(j) = (lateral(sp) - r) / 1e-7;
+    }
+    const Eigen::Vector2d d = J.fullPivLu().solve(-r);
+    s[1] += d[0];
+    s[2] += d[1];
+  }
+  return piola(element_state(FemLaw::NeoHookean, s.asDiagonal().toDenseMatrix(), 0.0), m)(0, 0);
+}
+
+TEST(FemFibres, UniaxialStretchAlongAndAcrossTheFibresFollowsTheClosedForm) {
+  // Compared: the nominal stress of uniaxial stress at λ = 1.05 … 1.3 with ν = 0.4999 against the
+  // incompressible closed forms (Holzapfel 2000 §6.5 for the matrix; the fibre term of fem_element.h)
+  //   along the fibres:  P = μ(λ − λ⁻²) + 2ψ'(λ²) λ,   ψ'(I₄) = k₁(I₄ − 1)e^{k₂(I₄−1)²},
+  //   across them:       P = μ(λ − λ⁻²)   (the fibres shorten by λ^{-1/2} and carry nothing).
+  // Tolerance 0.5 %: the compressible law at K/μ = 5000 departs from incompressibility by
+  // O(σ/K) ≈ 0.05 %, and the fibre term, not split into isochoric and volumetric parts, by as much.
+  // Then the ratio of the small-strain moduli (λ = 1.0005) against 1 + 4k₁/(3μ) = 1.893 for k₁ = 0.67μ,
+  // the ratio Song 2006 measured across and along the wall, within 0.5 %.
+  const TetMaterial matrix = TetMaterial::from_young_poisson(30e3, 0.4999);
+  for (double k2 : {0.0, 2.0}) {
+    const TetMaterial along = with_fibre(matrix, Vec3::UnitX(), 0.67, k2);
+    const TetMaterial across = with_fibre(matrix, Vec3::UnitY(), 0.67, k2);
+    for (double lambda : {1.05, 1.1, 1.2, 1.3}) {
+      SCOPED_TRACE("k2 " + std::to_string(k2) + ", stretch " + std::to_string(lambda));
+      const double e = lambda * lambda - 1.0;
+      const double matrix_p = matrix.mu * (lambda - 1.0 / (lambda * lambda));
+      const double fibre_p = 2.0 * along.fibre_k1_pa * e * std::exp(k2 * e * e) * lambda;
+      EXPECT_NEAR(uniaxial_nominal_stress(along, lambda), matrix_p + fibre_p, 5e-3 * (matrix_p + fibre_p));
+      EXPECT_NEAR(uniaxial_nominal_stress(across, lambda), matrix_p, 5e-3 * matrix_p);
+    }
+  }
+  const double small = 1.0005;
+  const TetMaterial along = with_fibre(matrix, Vec3::UnitX(), 0.67, 0.0);
+  const TetMaterial across = with_fibre(matrix, Vec3::UnitY(), 0.67, 0.0);
+  EXPECT_NEAR(uniaxial_nominal_stress(along, small) / uniaxial_nominal_stress(across, small), 1.0 + 4.0 * 0.67 / 3.0,
+              5e-3 * 1.893);
+}
+
+}  // namespace
+}  // namespace pneumo
