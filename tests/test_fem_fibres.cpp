@@ -1,14 +1,15 @@
 // The fibre term of the finite elements (solve/fem_element.h) and the wall's fibre directions
 // (mesh/wall_fibres.h) against truths computed here: the stress is the energy's gradient and its
 // derivative the stress's finite difference with fibres in tension, fibres carry nothing in
-// compression or under a rotation, and a uniaxial stretch along and across them follows the closed form
-// of an incompressible neo-Hookean matrix with fibres.
+// compression or under a rotation, a uniaxial stretch along and across them follows the closed form of
+// an incompressible neo-Hookean matrix with fibres, and the wall's fibres run round the body.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 #include <vector>
 
+#include "mesh/wall_fibres.h"
 #include "solve/fem_element.h"
 
 namespace pneumo {
@@ -141,6 +142,62 @@ TEST(FemFibres, UniaxialStretchAlongAndAcrossTheFibresFollowsTheClosedForm) {
   const TetMaterial across = with_fibre(matrix, Vec3::UnitY(), 0.67, 0.0);
   EXPECT_NEAR(uniaxial_nominal_stress(along, small) / uniaxial_nominal_stress(across, small), 1.0 + 4.0 * 0.67 / 3.0,
               5e-3 * 1.893);
+}
+
+// A ring of wall tetrahedra round the z axis at radius 0.1 m and one of viscera at its centre; one more
+// wall tetrahedron the caller leaves without fibres (a lung's).
+Mesh ring_mesh() {
+  Mesh m;
+  const double r = 0.1, s = 0.004;
+  auto add_tet = [&](const Vec3& c, Part part) {
+    const int32_t base = int32_t(m.rest_m.size());
+    for (const Vec3& d : {Vec3(0, 0, 0), Vec3(s, 0, 0), Vec3(0, s, 0), Vec3(0, 0, s)}) m.rest_m.push_back(c + d);
+    m.tets.push_back({base, base + 1, base + 2, base + 3});
+    m.tet_part.push_back(part);
+    m.tet_rest_volume_m3.push_back(s * s * s / 6.0);
+    m.tet_young_pa.push_back(60e3);
+    m.tet_poisson.push_back(0.45);
+  };
+  for (int k = 0; k < 16; ++k) {
+    const double a = 2.0 * 3.14159265358979323846 * k / 16.0;
+    add_tet(Vec3(r * std::cos(a) + 0.03, r * std::sin(a) - 0.02, 0.001), Part::Wall);   // axis at (0.03, −0.02)
+  }
+  add_tet(Vec3(0.03, -0.02, 0.001), Part::Viscera);
+  add_tet(Vec3(0.03 + r, -0.02, 0.001), Part::Wall);
+  return m;
+}
+
+TEST(WallFibres, RunRoundTheBodyInTheAxialPlane) {
+  // Compared: each fibrous wall tetrahedron's fibre against ẑ × r̂, r̂ the unit radial from the body's
+  // axis, which is the volume-weighted mean of all tetrahedra's centres in the slab (wall_fibres.h;
+  // computed here from the 18 equal tetrahedra, 6 mm off the ring's centre because of the 18th);
+  // |a₀| = 1 and a₀·ẑ = 0; the viscera's and the non-fibrous tetrahedron's against none; k₁ against
+  // 0.67 μ. Tolerance 1e-9: rounding.
+  Mesh m = ring_mesh();
+  std::vector<uint8_t> fibrous(m.tets.size(), 1);
+  fibrous[16] = 0;   // the viscera: the caller marks wall tetrahedra only
+  fibrous[17] = 0;   // a lung's
+  assign_wall_fibres(m, fibrous, 0.67, 1.5);
+  std::vector<Vec3> centre(m.tets.size(), Vec3::Zero());
+  Vec3 axis = Vec3::Zero();
+  for (std::size_t t = 0; t < m.tets.size(); ++t) {
+    for (int32_t n : m.tets[t]) centre[t] += 0.25 * m.rest_m[n];
+    axis += centre[t] / double(m.tets.size());
+  }
+  EXPECT_GT(axis[0] - 0.03, 0.005);   // the 18th tetrahedron moves the axis; the rule must follow it
+  EXPECT_EQ(m.fibre_k2, 1.5);
+  for (int t = 0; t < 16; ++t) {
+    const Vec3 radial = Vec3(centre[t][0] - axis[0], centre[t][1] - axis[1], 0.0).normalized();
+    const Vec3 expected = Vec3::UnitZ().cross(radial);
+    EXPECT_NEAR(m.tet_fibre[t].norm(), 1.0, 1e-12);
+    EXPECT_NEAR(m.tet_fibre[t][2], 0.0, 1e-12);
+    EXPECT_LT((m.tet_fibre[t] - expected).norm(), 1e-9) << "tetrahedron " << t;
+    EXPECT_NEAR(m.tet_fibre_k1_pa[t], 0.67 * 60e3 / (2.0 * 1.45), 1e-9);
+  }
+  for (int t : {16, 17}) {
+    EXPECT_EQ(m.tet_fibre[t].norm(), 0.0);
+    EXPECT_EQ(m.tet_fibre_k1_pa[t], 0.0);
+  }
 }
 
 }  // namespace

@@ -520,6 +520,10 @@ TEST(SceneRules, FiniteElementsNeedAStaticSolverAndRefuseTheSpringsOwnKeys) {
   EXPECT_CONTAINS(error_of(j), "material.stiffening = 5");
   j = {{"material", {{"model", "fem-neohookean"}, {"volume_stiffness_kpa", 60}}}, {"solver", {{"method", "newton"}}}};
   EXPECT_CONTAINS(error_of(j), "material.volume_stiffness_kpa = 60");
+  // The springs have no fibres: asking for the wall's is refused, not ignored.
+  j = {{"material", {{"model", "msd"}, {"wall_fibre_stiffness", 0.67}}}, {"solver", {{"method", "newton"}}}};
+  EXPECT_CONTAINS(error_of(j), "material.wall_fibre_stiffness = 0.67 needs finite elements");
+  EXPECT_NO_THROW(parse_scene({{"material", {{"wall_fibre_stiffness", 0.67}, {"wall_fibre_exponent", 2}}}}, kOrigin));
   j = {{"material", {{"model", "fem-neohookean"}, {"stiffening", 5}, {"wall_poisson_ratio", 0.49},
                      {"viscera_poisson_ratio", nullptr}}},
        {"solver", {{"method", "newton"}}}};

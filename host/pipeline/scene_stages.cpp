@@ -3,12 +3,44 @@
 #include <cmath>
 
 #include "core/units.h"
+#include "anatomy/distance_transform.h"
 #include "io/volume_io.h"
+#include "mesh/wall_fibres.h"
 #include "scene/scene_presets.h"
 
 namespace pneumo {
 
 namespace {
+
+// The wall tetrahedra that carry the wall's fibres (mesh/wall_fibres.h): those of the abdominal wall's
+// shell, within roles.auto_wall_thickness_mm (skin, fat and muscle of an adult abdomen) of the air round
+// the body (every voxel of no role), and not lung. The voxel at the tetrahedron's rest centre decides.
+// So the diaphragm's dome, the retroperitoneal organs and the psoas, deeper than the shell, take none:
+// their fibres, where they have any, do not run round the body.
+std::vector<uint8_t> fibrous_tets(const Mesh& m, const VoxelRoles& roles, const Scene& scene) {
+  std::vector<uint8_t> fibrous(m.tets.size(), 0);
+  const Geometry& g = roles.geometry;
+  std::vector<uint8_t> inside(std::size_t(g.voxel_count()));
+  for (std::size_t v = 0; v < inside.size(); ++v) inside[v] = roles.role[v] != Role::Other;
+  const std::vector<float> depth_mm = distance_to_outside_mm(inside, g);
+  for (std::size_t t = 0; t < m.tets.size(); ++t) {
+    if (m.tet_part[t] != Part::Wall) continue;
+    Vec3 centre = Vec3::Zero();
+    for (int32_t n : m.tets[t]) centre += 0.25 * m.rest_m[n];
+    const Vec3 ijk = g.to_index(centre * 1e3);
+    int64_t i[3];
+    bool inside_grid = true;
+    for (int a = 0; a < 3; ++a) {
+      i[a] = int64_t(std::lround(ijk[a]));
+      inside_grid = inside_grid && i[a] >= 0 && i[a] < g.dims[a];
+    }
+    if (!inside_grid) continue;
+    const int64_t v = g.linear_index(i[0], i[1], i[2]);
+    const bool lung = scene.is_lung_voxel(roles.role[v], roles.label ? roles.label[v] : 0, roles.hu ? roles.hu[v] : 0.0f);
+    fibrous[t] = !lung && depth_mm[std::size_t(v)] <= scene.roles.auto_wall_thickness_mm;
+  }
+  return fibrous;
+}
 
 RoleInputNames input_names(const Scene& s) {
   RoleInputNames n;
@@ -68,6 +100,9 @@ Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene, bool to_solve
   mat.damping_ratio = scene.material.damping_ratio;
   mat.spring_scale = scene.material.spring_scale;
   assign_material(m, mat);
+  if (scene.material.wall_fibre_stiffness > 0.0 && scene.material.model != MaterialModel::Msd)
+    assign_wall_fibres(m, fibrous_tets(m, roles, scene), scene.material.wall_fibre_stiffness,
+                      scene.material.wall_fibre_exponent);
   return m;
 }
 

@@ -86,6 +86,11 @@ struct SceneMaterial {
   // (the Kirchhoff mean stress of the neo-Hookean law is −K ln J); its shear modulus stays the
   // viscera's. null = off (the liver is viscera like any other). docs/fidelity.md, "The viscera's volume".
   std::optional<double> liver_volume_loss = 0.12;
+  // The wall's circumferential collagen fibres (mesh/wall_fibres.h, solve/fem_element.h): k₁ of the fibre
+  // term as a multiple of each tetrahedron's shear modulus (0 = an isotropic wall), and k₂. 0.67 gives
+  // Song 2006's ratio of 1.89 between the wall's transverse and sagittal stiffness.
+  double wall_fibre_stiffness = 0.0;
+  double wall_fibre_exponent = 0.0;
   bool mean_dilatation = true;    // FEM: volumetric strain averaged per cube, against locking
   // b of the stiffening law (springs: solve/forces.h; fem-neohookean: Demiray); 0 = linear. 10 gives the
   // real CT McDougall's pressure-volume shape (docs/fidelity.md §3): a calibration.

@@ -84,6 +84,10 @@ void check_material_model(const Scene& s, const At& root) {
                                                     "or \"implicit-euler\", or leave attached_labels empty");
   if (m.tilt_deg != 0.0 && !m.gravity)
     root.child("material").child("tilt_deg").fail_value(m.tilt_deg, "tilts gravity, which is off: set gravity to true");
+  if (m.model == MaterialModel::Msd && m.wall_fibre_stiffness > 0.0)
+    root.child("material").child("wall_fibre_stiffness").fail_value(m.wall_fibre_stiffness,
+                                                                    "needs finite elements; the springs have no "
+                                                                    "fibres: use \"fem-neohookean\", or 0");
   if (m.model == MaterialModel::Msd) return;
   // The explicit schemes need the springs' dampers and stable step, the 2004 scheme their stiffness
   // sums; the finite elements have neither (docs/fem.md). Implicit Euler damps by Rayleigh's C.
