@@ -89,3 +89,35 @@ TEST(SkinArea, FacesTowardThePaddingOrTissueInsideTheBodyAreNoSkin) {
   EXPECT_NEAR(wall_skin_area(b.view(), b.body, still).rest_mm2, kBlockMm2 - 3 * 4, 1e-9);
   EXPECT_NEAR(wall_skin_area(b.view({-1, -1, 3}), b.body, still).rest_mm2, kBlockMm2 - 3 * 4 - 8 * 9, 1e-9);
 }
+
+TEST(SkinArea, TheAnteriorSkinIsWhatLiesWithinTheSectorOfStraightAheadOverTheViscera) {
+  // The body's axis in each slice is the block's centroid (x 0, y 21 mm). Within 60° of anterior (+y)
+  // lie the front (8 × 8 mm: 64 mm², 34° at most), the sides' front row (centres 4 mm aside and 3 mm
+  // ahead: 53°; 2 sides × 2 slices × 3 × 4 mm = 48 mm²) and the top's and bottom's front row (1 or 3 mm
+  // aside, 3 mm ahead: 45° at most; 2 × 4 × 2 × 3 mm = 48 mm²); the rows level with the axis (90°) and
+  // behind it are out: 160 mm². A uniform scaling grows it by s², as the whole skin; a map that moves
+  // only what lies behind y = 21 mm changes the whole skin and leaves the anterior skin alone.
+  // Behind the block (j = 1) a row of viscera, except behind i = 2, where a bone voxel is: the skin in
+  // front of that column lies over bone (one column of the front, 2 slices × 2 × 4 mm, and the left
+  // side's front row, 2 × 3 × 4 mm, and the top's and bottom's, 2 × 2 × 3 mm, are out: 160 − 52 = 108 mm²).
+  // The whole skin keeps everything but the block's back.
+  Block b = block();
+  for (int64_t k = 2; k <= 3; ++k)
+    for (int64_t i = 2; i <= 5; ++i) {
+      b.role[std::size_t(b.g.linear_index(i, 1, k))] = i == 2 ? Role::Fixed : Role::Viscera;
+    }   // (the body mask stays the block's, so the axis does not move; the block's back is no skin now)
+  const SkinArea scaled = wall_skin_area(b.view(), b.body, [](const Vec3& p, Vec3& q) {
+    q = Vec3(1, 20, 50) + 1.2 * (p - Vec3(1, 20, 50));
+    return true;
+  });
+  EXPECT_NEAR(scaled.anterior_rest_mm2, 108.0, 1e-9);
+  EXPECT_NEAR(scaled.anterior_change(), 1.2 * 1.2 - 1.0, 1e-12);
+  const SkinArea back = wall_skin_area(b.view(), b.body, [](const Vec3& p, Vec3& q) {
+    q = p[1] < 21.0 ? Vec3(1.3 * p[0], p[1] - 2.0, p[2]) : p;
+    return true;
+  });
+  EXPECT_GT(std::abs(back.change()), 0.01);
+  EXPECT_NEAR(back.anterior_change(), 0.0, 1e-12);
+  EXPECT_NEAR(wall_skin_area(b.view(), b.body, [](const Vec3& p, Vec3& q) { q = p; return true; }, 91.0).anterior_rest_mm2,
+              108.0 + 2 * 12 + 2 * 3 * 6, 1e-9);   // past 90°: the rows level with the axis join, less the bone's column
+}

@@ -413,6 +413,10 @@ nlohmann::json warp_metrics(const Scene& scene, const WarpedCase& w) {
       j["wall_skin_area_cm2"] = skin.rest_mm2 / 100.0;
       j["wall_skin_area_change_fraction"] = skin.change();
     }
+    if (skin.anterior_rest_mm2 > 0.0) {
+      j["anterior_skin_area_cm2"] = skin.anterior_rest_mm2 / 100.0;
+      j["anterior_skin_area_change_fraction"] = skin.anterior_change();
+    }
     // The diaphragm's rise into the chest (pipeline/diaphragm_motion.h), where a lung base is in view.
     ThoraxOptions lungs_only;
     lungs_only.lung_closing_mm = 0.0;   // the lungs' base is all it needs: no closing
