@@ -22,7 +22,9 @@
 #include "core/progress.h"
 #include "opencl_test_support.h"
 #include "phantom/phantom.h"
+#include "pipeline/scene_stages.h"
 #include "pipeline/simulate.h"
+#include "solve/solve_on_device.h"
 
 namespace pneumo {
 namespace {
@@ -64,6 +66,8 @@ void expect_identical_runs(Scene scene) {
   int64_t differing = 0;
   for (std::size_t n = 0; n < a.result.x.size(); ++n) differing += a.result.x[n] != b.result.x[n];
   EXPECT_EQ(differing, 0) << "nodes whose final position differs between two runs on " << a.device;
+  // The device that ran, not the one asked for: an OpenCL request runs there (no fallback allowed here).
+  EXPECT_EQ(a.device.rfind(scene.device.rfind("opencl", 0) == 0 ? "opencl:" : "cpu", 0), 0u) << a.device;
   ASSERT_EQ(a.result.history.size(), b.result.history.size());
   for (std::size_t h = 0; h < a.result.history.size(); ++h) {
     EXPECT_EQ(a.result.history[h].residual, b.result.history[h].residual) << "history row " << h;
@@ -162,9 +166,14 @@ TEST_P(DeterminismPerSolver, TwoRunsEndBitIdentical) {
   // The explicit, Newmark and 2004 schemes take the springs only; the others the default material.
   if (!solves_force_fields(*enum_from_name<SolverMethod>(method))) j["material"] = testing_support::springs_material_json();
   j["device"] = device;
+  j["solver"]["allow_cpu_fallback"] = true;   // static on the finite elements has no device scheme
   Progress::set_enabled(false);
   const Scene scene = load_scene(testing_support::write_tiny_case(dir, j));
   const Simulation a = simulate_scene(scene), b = simulate_scene(scene);
+  // Labelled by the device that ran: the CPU where OpenCL lacks the scheme, the device where it has it.
+  const bool on_device = device != "cpu" && device_implements(solve_options_from_scene(scene));
+  EXPECT_EQ(a.device.rfind(on_device ? "opencl:" : "cpu", 0), 0u) << a.device << " for " << method << " on " << device;
+  EXPECT_EQ(a.device, b.device);
   ASSERT_EQ(a.result.x.size(), b.result.x.size());
   EXPECT_GT(a.result.steps, 0);
   EXPECT_EQ(a.result.steps, b.result.steps);

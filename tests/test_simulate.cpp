@@ -158,6 +158,7 @@ void expect_same_equilibrium_on_opencl(Scene scene) {
   scene.device = "opencl";
   const Simulation dev = simulate_scene(scene);
   ASSERT_TRUE(cpu.result.converged && dev.result.converged) << cpu.result.stop_reason << " / " << dev.result.stop_reason;
+  EXPECT_EQ(dev.device.rfind("opencl:", 0), 0u) << "the comparison needs the device to run it, not " << dev.device;
   double worst = 0.0;
   for (int64_t n = 0; n < cpu.mesh.node_count(); ++n)
     worst = std::max(worst, (cpu.result.x[n] - dev.result.x[n]).norm() * 1e3);
@@ -179,9 +180,12 @@ TEST(Simulate, OpenClReachesTheCpuEquilibriumOnThePhantom) {
 TEST(Simulate, OpenClReachesTheCpuEquilibriumOnTheRealCt) {
   PNEUMO_REQUIRE_REAL_CT();
   Progress::set_enabled(false);
-  // The springs' scene; the default elements' devices on the real CT: the next test.
-  expect_same_equilibrium_on_opencl(
-      load_scene(std::string(PNEUMO_SOURCE_DIR) + "/scenes/totalseg_example_springs.json"));
+  // The springs' scene; the default elements' devices on the real CT: the next test. The springs'
+  // device schemes have no interface bond, so the attached interfaces are left out here: with them the
+  // device cannot run it, and until a fallback had to be allowed this test compared the CPU with itself.
+  Scene scene = load_scene(std::string(PNEUMO_SOURCE_DIR) + "/scenes/totalseg_example_springs.json");
+  scene.mesh.attached_labels.clear();
+  expect_same_equilibrium_on_opencl(scene);
 }
 
 TEST(Simulate, RealCtInflatesWithFiniteElementsOnEveryDevice) {

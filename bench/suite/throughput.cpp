@@ -196,6 +196,8 @@ json measure_case_throughput(BenchContext& ctx, const BenchCase& c, int pipeline
   const SolveOptions base = [&] {
     SolveOptions o = solve_options_from_scene(c.scene);
     o.progress = false;
+    // A device without the case's scheme: the CPU solves it, and the row says so (solve.result.device).
+    o.allow_cpu_fallback = true;
     return o;
   }();
   const int width = ctx.quick() ? 128 : c.scene.render.width, height = ctx.quick() ? 96 : c.scene.render.height;
@@ -249,7 +251,11 @@ json measure_case_throughput(BenchContext& ctx, const BenchCase& c, int pipeline
         render_s.push_back(frame);
         total_s.push_back(solve_s.back() + warp_s.back() + frame);
         solve_info = {{"steps", r.steps}, {"force_evaluations", r.force_evaluations}, {"converged", r.converged},
-                      {"stop_reason", stop_reason_text(r.stop_reason)}, {"residual", r.residual}};
+                      {"stop_reason", stop_reason_text(r.stop_reason)}, {"residual", r.residual}, {"device", r.device}};
+        if (!r.device_fallback.empty() && rep == 0) {
+          solve_info["device_fallback"] = r.device_fallback;
+          ctx.note(c.name + " on " + d.name + ": the solve ran on the CPU (" + r.device_fallback + ")");
+        }
         last_warp = std::move(w);
       }
       const Summary solve = summarize(solve_s), warp = summarize(warp_s);

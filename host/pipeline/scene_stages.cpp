@@ -138,6 +138,7 @@ SolveOptions solve_options_from_scene(const Scene& s) {
   o.kitasaka_step = s.solver.kitasaka_step;
   o.kitasaka_tolerance_m = s.solver.kitasaka_tolerance_mm * units::kMetresPerMm;
   o.on_inverted = s.solver.on_inverted;
+  o.allow_cpu_fallback = s.solver.allow_cpu_fallback || s.device == "auto";
   return o;
 }
 

@@ -43,8 +43,22 @@ void throw_if_stopped_inverted(const SolveResult& r, const Mesh& m, double targe
 }
 }  // namespace
 
+namespace {
+// A device that cannot run the scene's solver is refused before the roles and the mesh, not after them
+// (solve_on_device refuses it too, for callers that skip this).
+void require_device_runs_solver(const Scene& scene) {
+  const SolveOptions opt = solve_options_from_scene(scene);
+  if (opt.allow_cpu_fallback || !ocl::parse_device_spec(scene.device).use_opencl) return;
+  const std::string why = device_shortfall(opt);
+  if (!why.empty())
+    throw InputError("scene " + scene.path + ": device \"" + scene.device + "\" cannot run this solve: " + why +
+                     ". Choose device \"cpu\", or set solver.allow_cpu_fallback to solve on the CPU");
+}
+}  // namespace
+
 Simulation prepare_simulation(const Scene& scene, bool keep_inputs) {
   fit_threads_to_load();
+  require_device_runs_solver(scene);
   Simulation sim;
   auto t0 = std::chrono::steady_clock::now();
   sim.roles = load_roles(scene, keep_inputs ? &sim.inputs : nullptr);
@@ -87,10 +101,7 @@ void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hoo
   std::shared_ptr<ocl::Context> ctx;
   if (device.use_opencl) {
     ctx = ocl::Context::shared(device);
-    sim.device = ctx->info().spec() + " " + ctx->info().name;
-    log::info("solving on " + sim.device);
-  } else {
-    sim.device = "cpu";
+    if (device_implements(solve_options_from_scene(scene))) log::info("solving on " + ctx->info().spec() + " " + ctx->info().name);
   }
   SolveOptions base = solve_options_from_scene(scene);
   // With gravity compensated the solver's rest shape is the unloaded one, and every solve starts at
@@ -105,7 +116,10 @@ void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hoo
   }
   const Mesh& solver_mesh = unloaded ? *unloaded : sim.mesh;
   auto run = [&](const SolveOptions& opt, const std::vector<Vec3>& x_start) {
-    return solve_on_device(ctx.get(), solver_mesh, opt, x_start.empty() ? sim.mesh.rest_m : x_start);
+    SolveResult r = solve_on_device(ctx.get(), solver_mesh, opt, x_start.empty() ? sim.mesh.rest_m : x_start);
+    sim.device = r.device;
+    sim.device_fallback = r.device_fallback;
+    return r;
   };
   base.snapshot_every_steps = hooks.snapshot_every_steps;
   base.on_snapshot = hooks.on_snapshot;
@@ -218,6 +232,8 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   j["pneumo_version"] = PNEUMO_VERSION;
   j["scene"] = scene.path;
   j["device"] = sim.device;
+  j["device_requested"] = scene.device;
+  if (!sim.device_fallback.empty()) j["device_fallback"] = sim.device_fallback;
   j["converged"] = r.converged;
   j["stop_reason"] = stop_reason_text(r.stop_reason);
   j["solver"] = r.solver;

@@ -35,7 +35,8 @@ struct Simulation {
   GravityCompensation gravity;
   SolveResult result;                         // at the scene's load.pressure_mmhg
   std::vector<PressurePoint> pressure_curve;  // when the scene lists pressures (§9), in order
-  std::string device;   // "cpu" or "opencl:P:D <name>"
+  std::string device;            // where the solve ran: "cpu" or "opencl:P:D <name>"
+  std::string device_fallback;   // why the scene's device did not run it (solver.allow_cpu_fallback); empty when it did
   InputVolumes inputs;  // the CT and labels as read, when prepare_simulation was asked to keep them
   double stage_seconds_roles = 0, stage_seconds_mesh = 0, stage_seconds_solve = 0;
 };

@@ -115,6 +115,9 @@ struct SceneLoad {
 
 struct SceneSolver {
   SolverMethod method = SolverMethod::Newton;   // converges for every model; FIRE diverges on the FEM
+  // An OpenCL device that cannot run the method and model: refuse (false) or solve on the CPU and
+  // report it (true; device "auto" always may: it asks for the best there is).
+  bool allow_cpu_fallback = false;
   double dt_ms = 0.0;                    // 0 = dt_safety × the stability bound (§6)
   double dt_safety = 0.5;
   int64_t max_steps = 100000;

@@ -342,6 +342,11 @@ const Table<SceneSolver>& solver_table() {
        "Δs of the 2004 scheme, R += Δs F/D (§6; Kitasaka 0.3)."},
       {"kitasaka_tolerance_mm", &SceneSolver::kitasaka_tolerance_mm, "mm", above(0, 1e9),
        "β of the 2004 scheme: stop when Σ|ΔR| over all nodes is below it (Kitasaka Eq. 3; scales with node count)."},
+      {"allow_cpu_fallback", &SceneSolver::allow_cpu_fallback, "", any(),
+       "When the scene's OpenCL device cannot run solver.method with material.model (OpenCL solves newton on the "
+       "finite elements, the other schemes on the springs without contact or bonded interfaces): false refuses the run before it "
+       "starts; true solves on the CPU and says so in metrics.json (device, device_fallback). Device \"auto\" "
+       "always may."},
       {"on_inverted", &SceneSolver::on_inverted, "", any(),
        "When a tetrahedron turns inside out: \"continue\" (counted and reported) or \"stop\"."},
       {"checkpoint_every_steps", &SceneSolver::checkpoint_every_steps, "", in(0, 1e9),

@@ -2,6 +2,7 @@
 
 #include <atomic>
 
+#include "core/error.h"
 #include "core/log.h"
 #include "solve/contact.h"
 #include "solve/fem_force_field_cl.h"
@@ -19,23 +20,44 @@ bool device_implements(const SolveOptions& opt) {
   return opt.method == SolverMethod::Newton ? fem : !fem;
 }
 
+std::string device_shortfall(const SolveOptions& opt) {
+  if (device_implements(opt)) return "";
+  const bool ties = opt.forces.tie_interface || opt.forces.tie_attached;
+  return std::string("OpenCL solves newton on the finite elements, and the other schemes on the springs without "
+                     "contact or bonded interfaces; not ") +
+         enum_name(opt.method) + " with " + enum_name(opt.forces.material) +
+         (opt.forces.contact_stiffness > 0.0 ? " and contact" : "") +
+         (ties ? " and bonded interfaces (mesh.attached_labels)" : "");
+}
+
 SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions& opt,
                             const std::vector<Vec3>& x_start) {
   if (ctx && device_implements(opt)) {
-    if (opt.method != SolverMethod::Newton) return solve_opencl(*ctx, m, opt, x_start);
-    const std::unique_ptr<ForceField> field =
-        with_interface_tie(m, opt.forces, with_contact(m, opt.forces, make_fem_force_field_cl(*ctx, m, opt.forces.material)));
-    return solve_newton_on(m, opt, *field, x_start);
+    SolveResult r;
+    if (opt.method != SolverMethod::Newton) {
+      r = solve_opencl(*ctx, m, opt, x_start);
+    } else {
+      const std::unique_ptr<ForceField> field =
+          with_interface_tie(m, opt.forces, with_contact(m, opt.forces, make_fem_force_field_cl(*ctx, m, opt.forces.material)));
+      r = solve_newton_on(m, opt, *field, x_start);
+    }
+    r.device = ctx->info().spec() + " " + ctx->info().name;
+    return r;
   }
+  std::string fallback;
   if (ctx) {
+    const std::string why = device_shortfall(opt);
+    if (!opt.allow_cpu_fallback)
+      throw InputError(ctx->info().spec() + " cannot run this solve: " + why +
+                       ". Choose device \"cpu\", or set solver.allow_cpu_fallback to solve on the CPU");
+    fallback = ctx->info().spec() + ": " + why;
     static std::atomic<bool> said{false};
-    if (!said.exchange(true))
-      log::info(std::string("solving on the CPU: on OpenCL, newton solves the finite elements and the other "
-                            "schemes the springs without contact, not ") +
-                enum_name(opt.method) + " with " + enum_name(opt.forces.material) +
-                (opt.forces.contact_stiffness > 0.0 ? " and contact" : ""));
+    if (!said.exchange(true)) log::info("solving on the CPU: " + why);
   }
-  return solve(m, opt, x_start);
+  SolveResult r = solve(m, opt, x_start);
+  r.device = "cpu";
+  r.device_fallback = fallback;
+  return r;
 }
 
 }  // namespace pneumo

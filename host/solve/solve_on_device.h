@@ -1,6 +1,7 @@
 #pragma once
 // The one entry through which the pipeline and the benchmarks solve: the device is chosen here,
 // not by each caller. A new back end is a new case here.
+#include <string>
 #include <vector>
 
 #include "cl/cl_runtime.h"
@@ -13,8 +14,13 @@ namespace pneumo {
 /// the host); Newton on the springs runs on the CPU.
 bool device_implements(const SolveOptions& opt);
 
-/// Solves on `ctx` when it is given and implements the options, on the CPU otherwise (saying so
-/// once per process when a device was asked for).
+/// Why OpenCL cannot solve these options ("" when it can): one sentence naming what it does solve.
+std::string device_shortfall(const SolveOptions& opt);
+
+/// Solves on `ctx` when it is given and implements the options, on the CPU without one. Given one that
+/// does not implement them: InputError naming the choice, unless opt.allow_cpu_fallback, then on the
+/// CPU, saying so once per process and in SolveResult::device_fallback. SolveResult::device is where
+/// it ran, never only what was asked for.
 SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions& opt,
                             const std::vector<Vec3>& x_start = {});
 

@@ -51,6 +51,9 @@ struct SolveOptions {
   int64_t snapshot_every_steps = 0;
   std::function<void(const SolverSnapshot&)> on_snapshot;
   bool progress = true;
+  // A device asked for that does not implement the method and model (solve_on_device.h): false refuses
+  // the solve with an InputError; true solves on the CPU and says so in SolveResult::device_fallback.
+  bool allow_cpu_fallback = false;
 };
 
 /// Host memory a solve allocates beside its mesh, per node and per tetrahedron: an allowance for the
@@ -89,6 +92,8 @@ struct SolveResult {
   double wall_time_s = 0, residual = 0, dt_s = 0, dt_stable_s = 0, final_pressure_pa = 0;
   int64_t inverted_tetrahedra = 0;
   std::vector<SolveSample> history;
+  std::string device = "cpu";       // where it ran: "cpu", or "opencl:P:D <name>" (solve_on_device.h)
+  std::string device_fallback;      // why the device asked for did not run it; empty when it did
 };
 
 /// A run that blew up. The message names the parameter to change and the largest stable step.
