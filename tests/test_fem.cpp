@@ -18,6 +18,7 @@
 #include "solve/solve_on_device.h"
 #include "solve/solver.h"
 #include "validate/validate.h"
+#include "fem_test_support.h"
 #include "mesh_test_support.h"
 #include "opencl_test_support.h"
 
@@ -29,12 +30,7 @@ const TetMaterial kLame = TetMaterial::from_young_poisson(60e3, 0.45);
 
 Mat3 rotation(const Vec3& axis, double angle) { return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix(); }
 
-Mat3 random_matrix(std::mt19937& rng, double amplitude) {
-  std::uniform_real_distribution<double> u(-amplitude, amplitude);
-  Mat3 m;
-  for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = u(rng);
-  return m;
-}
+using testing_support::random_matrix;
 
 struct LawCase {
   FemLaw law;
@@ -81,16 +77,7 @@ TEST(FemElement, StressIsTheGradientOfTheEnergy) {
       SCOPED_TRACE(std::string(c.name) + " sample " + std::to_string(k));
       const Mat3 F = rotation(Vec3(0.3, 1, 0.2), 0.7 * k) * (Mat3::Identity() + random_matrix(rng, 0.3));
       const Mat3 P = piola(element_state(c.law, F, c.b), kLame);
-      Mat3 fd;
-      const double h = 1e-6;
-      for (int i = 0; i < 9; ++i) {
-        Mat3 Fp = F, Fm = F;
-        Fp(i / 3, i % 3) += h;
-        Fm(i / 3, i % 3) -= h;
-        fd(i / 3, i % 3) = (energy_density(element_state(c.law, Fp, c.b), kLame) -
-                            energy_density(element_state(c.law, Fm, c.b), kLame)) / (2 * h);
-      }
-      EXPECT_LT((P - fd).norm(), 1e-6 * P.norm());
+      EXPECT_LT((P - testing_support::energy_gradient_fd(c.law, F, c.b, kLame)).norm(), 1e-6 * P.norm());
     }
 }
 
@@ -104,10 +91,7 @@ TEST(FemElement, StressDerivativeIsTheFiniteDifferenceOfTheStress) {
       const Mat3 F = rotation(Vec3(1, -0.4, 0.8), 0.9 * k) * (Mat3::Identity() + random_matrix(rng, 0.3));
       const Mat3 dF = random_matrix(rng, 1.0);
       const Mat3 dP = dpiola(element_state(c.law, F, c.b), dF, kLame);
-      const double h = 1e-6;
-      const Mat3 fd = (piola(element_state(c.law, F + h * dF, c.b), kLame) -
-                       piola(element_state(c.law, F - h * dF, c.b), kLame)) / (2 * h);
-      EXPECT_LT((dP - fd).norm(), 1e-6 * dP.norm());
+      EXPECT_LT((dP - testing_support::piola_derivative_fd(c.law, F, dF, c.b, kLame)).norm(), 1e-6 * dP.norm());
     }
 }
 

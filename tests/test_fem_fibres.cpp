@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "fem_test_support.h"
 #include "mesh/wall_fibres.h"
 #include "solve/fem_element.h"
 
@@ -24,12 +25,7 @@ TetMaterial with_fibre(TetMaterial m, const Vec3& a, double k1_over_mu, double k
   return m;
 }
 
-Mat3 random_matrix(std::mt19937& rng, double amplitude) {
-  std::uniform_real_distribution<double> u(-amplitude, amplitude);
-  Mat3 m;
-  for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = u(rng);
-  return m;
-}
+using testing_support::random_matrix;
 
 struct Case {
   FemLaw law;
@@ -57,20 +53,10 @@ TEST(FemFibres, StressIsTheGradientOfTheEnergyAndItsDerivativeTheStresssDifferen
       (i4 > 1.0 ? tension : compression) += 1;
       const ElementState s = element_state(c.law, F, c.b);
       const Mat3 P = piola(s, m);
-      Mat3 fd;
-      const double h = 1e-6;
-      for (int i = 0; i < 9; ++i) {
-        Mat3 Fp = F, Fm = F;
-        Fp(i / 3, i % 3) += h;
-        Fm(i / 3, i % 3) -= h;
-        fd(i / 3, i % 3) = (energy_density(element_state(c.law, Fp, c.b), m) -
-                            energy_density(element_state(c.law, Fm, c.b), m)) / (2 * h);
-      }
-      EXPECT_LT((P - fd).norm(), 1e-6 * P.norm());
+      EXPECT_LT((P - testing_support::energy_gradient_fd(c.law, F, c.b, m)).norm(), 1e-6 * P.norm());
       const Mat3 dF = random_matrix(rng, 1.0);
       const Mat3 dP = dpiola(s, dF, m);
-      const Mat3 dfd = (piola(element_state(c.law, F + h * dF, c.b), m) - piola(element_state(c.law, F - h * dF, c.b), m)) / (2 * h);
-      EXPECT_LT((dP - dfd).norm(), 1e-6 * dP.norm());
+      EXPECT_LT((dP - testing_support::piola_derivative_fd(c.law, F, dF, c.b, m)).norm(), 1e-6 * dP.norm());
     }
   EXPECT_GT(tension, 10);       // both branches were sampled
   EXPECT_GT(compression, 10);
