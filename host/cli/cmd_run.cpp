@@ -2,6 +2,7 @@
 
 #include "cl/cl_runtime.h"
 #include "cli/commands.h"
+#include "cli/device_option.h"
 #include "cli/scene_inputs_options.h"
 #include "core/output_lock.h"
 #include "pipeline/run.h"
@@ -20,7 +21,7 @@ Run add_run(CLI::App& app) {
   auto o = std::make_shared<Opts>();
   add_scene_source_options(cmd, o->source);
   cmd->add_option("--out", o->out, "Output folder")->required();
-  cmd->add_option("--device", o->device, "cpu (the C++ reference), auto (an OpenCL GPU if there is one, else cpu), opencl or opencl:P:D; overrides the scene's device");
+  add_device_option(cmd, o->device, "Overrides the scene's device");
   cmd->add_option("--backend", o->backend, "Offscreen OpenGL: auto, egl-device, egl-surfaceless or osmesa");
   cmd->add_flag("--force", o->force, "Replace the results of an earlier run in --out");
   cmd->add_flag("--resume", o->resume, "Continue an interrupted run in --out from its checkpoint.bin");

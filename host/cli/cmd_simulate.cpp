@@ -3,6 +3,7 @@
 
 #include "cl/cl_runtime.h"
 #include "cli/commands.h"
+#include "cli/device_option.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/output_lock.h"
@@ -16,7 +17,7 @@ Run add_simulate(CLI::App& app) {
   auto o = std::make_shared<Opts>();
   cmd->add_option("scene", o->scene, "Scene .json")->required();
   cmd->add_option("--out", o->out, "Output folder")->required();
-  cmd->add_option("--device", o->device, "cpu (the C++ reference), auto (an OpenCL GPU if there is one, else cpu), opencl or opencl:P:D; overrides the scene's device");
+  add_device_option(cmd, o->device, "Overrides the scene's device");
   cmd->add_flag("--force", o->force, "Overwrite the results of an earlier run in --out");
   return [=] {
     Scene scene = load_scene(o->scene);

@@ -1,6 +1,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "cli/device_option.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "pipeline/convergence_study.h"
@@ -49,7 +50,7 @@ Run add_validate(CLI::App& app) {
       ->check(CLI::Range(0.1, 60.0));
   lame->add_flag("--per-tetrahedron", o->per_tetrahedron,
                  "FEM: the dilatation per tetrahedron instead of averaged per cube (shows volumetric locking)");
-  lame->add_option("--device", o->lame.device, "cpu, auto, opencl or opencl:P:D (the FEM models solve there; the springs' static solver too)")
+  add_device_option(lame, o->lame.device, "Where the sphere is solved (the FEM models' Newton and the springs' static solver run on OpenCL)")
       ->capture_default_str();
   lame->add_flag("--json", o->json, "Print JSON (u_inner_mm, u_inner_analytic_mm, rel_error_inner, ...)");
   auto* conv = cmd->add_subcommand(

@@ -5,6 +5,7 @@
 
 #include "cl/cl_runtime.h"
 #include "cli/commands.h"
+#include "cli/device_option.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/input_file.h"
@@ -31,7 +32,7 @@ Run add_warp(CLI::App& app) {
   auto o = std::make_shared<Opts>();
   cmd->add_option("scene", o->scene, "Scene .json (the one simulated)")->required();
   cmd->add_option("--out", o->out, "Folder of `pneumo simulate SCENE --out DIR`; the results go there too")->required();
-  cmd->add_option("--device", o->device, "cpu (the C++ reference), auto (an OpenCL GPU if there is one, else cpu), opencl or opencl:P:D; overrides the scene's device");
+  add_device_option(cmd, o->device, "Overrides the scene's device");
   cmd->add_flag("--force", o->force, "Overwrite the results of an earlier warp in --out");
   return [=] {
     Scene scene = load_scene(o->scene);

@@ -240,6 +240,10 @@ nlohmann::json port_json(const Port& p);
 /// otherwise. What `pneumo serve` reads the page's ports with.
 Port read_port(const nlohmann::json& j, const std::string& what);
 
+/// A scene key's meaning and what it allows, as the reference gives them ("device",
+/// "material.model"): the help of a command-line flag that sets the same thing, in the same words.
+std::string scene_key_help(const std::string& dotted_path);
+
 /// docs/scene_reference.md: one Markdown table per section, generated from the parameter table.
 std::string scene_reference_markdown();
 

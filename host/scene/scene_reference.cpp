@@ -2,6 +2,7 @@
 // per kind of array item, in the table's order. The test suite checks that the committed file is
 // this text, so the reference cannot fall behind the parser.
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "scene/param_table.h"
@@ -65,6 +66,21 @@ void write_table(std::ostringstream& md, const TableDoc& t, const std::string& t
 }
 
 }  // namespace
+
+std::string scene_key_help(const std::string& dotted_path) {
+  const TableDoc* table = &scene_detail::scene_table();
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t dot = dotted_path.find('.', start);
+    const std::string key = dotted_path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+    const ParamInfo* p = table->find(key);
+    if (!p) throw std::logic_error("scene_key_help: no scene key " + dotted_path);
+    if (dot == std::string::npos) return p->meaning + " Allowed: " + p->allowed_text() + ".";
+    if (!p->sub) throw std::logic_error("scene_key_help: " + key + " has no keys under it");
+    table = p->sub;
+    start = dot + 1;
+  }
+}
 
 std::string scene_reference_markdown() {
   std::ostringstream md;
