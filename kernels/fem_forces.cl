@@ -13,8 +13,10 @@
 // 1/Σ κ_t V_t. Per node: compressed rows of (tetrahedron × 8 + vertex), as host/mesh/adjacency.h.
 
 // State offsets: F (9), A (9: R, or F⁻ᵀ), B (9: the co-rotational (tr S·I − S)⁻¹), then e, J^{−2/3},
-// I₁, e^{b(Ī₁−3)}, valid, and the deviatoric energy density. The stride and the two offsets the host
-// reads (e for the group average, ψ for the energy) come from the host as build options
+// I₁, e^{b(Ī₁−3)}, valid, the deviatoric energy density, and for a tetrahedron with fibres 2ψ' and
+// 4ψ'' of the fibre term and F a₀ (S_FIB: computed once per state, not per stiffness product). The
+// stride and the two offsets the host reads (e for the group average, ψ for the energy) come from the
+// host as build options
 // (fem_force_field_cl.cpp), so the layout is written once on each side of what they share.
 #if !defined(kStateFloats) || !defined(S_E) || !defined(S_PSI)
 #error "fem_forces.cl needs -DkStateFloats, -DS_E and -DS_PSI (fem_force_field_cl.cpp)"
@@ -26,6 +28,10 @@
 #define S_I1 (S_E + 2)
 #define S_EXP (S_E + 3)
 #define S_VALID (S_E + 4)
+#define S_FIB (S_PSI + 1)
+#if S_FIB + 5 > kStateFloats
+#error "the fibre terms do not fit the state"
+#endif
 
 typedef struct { float m[9]; } mat3;   // row-major
 
@@ -195,19 +201,26 @@ inline float3 fibre_terms(mat3 F, float4 fib, float k2, float3* fa) {
   return (float3)(energy, fib.w * e * ex, fib.w * (1.0f + 2.0f * x) * ex);
 }
 
-// P_f = 2ψ' (F a₀) ⊗ a₀.
-inline mat3 fibre_piola(mat3 F, float4 fib, float k2) {
+// The fibre terms kept in the state (S_FIB): 2ψ', 4ψ'' and F a₀.
+inline void store_fibre_terms(mat3 F, float4 fib, float k2, __global float* st) {
   float3 fa;
   const float3 t = fibre_terms(F, fib, k2, &fa);
-  return m_outer(2.0f * t.y * fa, fib.xyz);
+  st[S_PSI] += t.x;
+  st[S_FIB] = 2.0f * t.y;
+  st[S_FIB + 1] = 4.0f * t.z;
+  st[S_FIB + 2] = fa.x; st[S_FIB + 3] = fa.y; st[S_FIB + 4] = fa.z;
+}
+
+// P_f = 2ψ' (F a₀) ⊗ a₀.
+inline mat3 fibre_piola(__global const float* st, float3 a0) {
+  return m_outer(st[S_FIB] * (float3)(st[S_FIB + 2], st[S_FIB + 3], st[S_FIB + 4]), a0);
 }
 
 // δP_f = (2ψ' δF a₀ + 4ψ'' ((F a₀)·(δF a₀)) F a₀) ⊗ a₀.
-inline mat3 fibre_dpiola(mat3 F, mat3 dF, float4 fib, float k2) {
-  float3 fa;
-  const float3 t = fibre_terms(F, fib, k2, &fa);
-  const float3 dfa = m_vec(dF, fib.xyz);
-  return m_outer(2.0f * t.y * dfa + 4.0f * t.z * dot(fa, dfa) * fa, fib.xyz);
+inline mat3 fibre_dpiola(__global const float* st, mat3 dF, float3 a0) {
+  const float3 fa = (float3)(st[S_FIB + 2], st[S_FIB + 3], st[S_FIB + 4]);
+  const float3 dfa = m_vec(dF, a0);
+  return m_outer(st[S_FIB] * dfa + st[S_FIB + 1] * dot(fa, dfa) * fa, a0);
 }
 
 // D_u of the vertices' displacements (or of a direction p).
@@ -235,8 +248,7 @@ __kernel void fem_states(__global const float4* restrict u, __global const int4*
     const float x = st[S_PSI];
     st[S_PSI] = tet_consts[t].y * (b > 0.0f ? expm1(b * x) / (2.0f * b) : 0.5f * x);
   }
-  float3 fa;
-  st[S_PSI] += fibre_terms(m_load(st + S_F), fibre[t], tet_consts[t].w, &fa).x;
+  if (fibre[t].w > 0.0f) store_fibre_terms(m_load(st + S_F), fibre[t], tet_consts[t].w, st);
 }
 
 // Group averages: out[g] = Σ_t w_t q_t / Σ_t w_t over the group's tetrahedra, q_t = per_tet[t * stride + offset].
@@ -312,7 +324,8 @@ __kernel void fem_forces(__global const float* restrict state, __global const fl
   if (t >= n_tets) return;
   __global const float* st = state + kStateFloats * t;
   const float4 c = tet_consts[t];   // V₀, μ, κ, k₂
-  const mat3 Pd = m_add(deviatoric_piola(law, st, c.y), fibre_piola(m_load(st + S_F), fibre[t], c.w));
+  mat3 Pd = deviatoric_piola(law, st, c.y);
+  if (fibre[t].w > 0.0f) Pd = m_add(Pd, fibre_piola(st, fibre[t].xyz));
   const mat3 P = m_axpy(c.z * ebar[group_of_tet[t]], dilatation_gradient(law, st), Pd);
   store_nodal_forces(P, rest_inverse(dm_inv, t), c.x, tet_force + 4 * t);
 }
@@ -341,7 +354,8 @@ __kernel void fem_dforces(__global const float* restrict state, __global const f
   const float4 c = tet_consts[t];
   const int g = group_of_tet[t];
   const mat3 d = m_load(dF + 10 * t);
-  mat3 dP = m_add(deviatoric_dpiola(law, st, d, c.y, b), fibre_dpiola(m_load(st + S_F), d, fibre[t], c.w));
+  mat3 dP = deviatoric_dpiola(law, st, d, c.y, b);
+  if (fibre[t].w > 0.0f) dP = m_add(dP, fibre_dpiola(st, d, fibre[t].xyz));
   dP = m_axpy(c.z * debar[g], dilatation_gradient(law, st), dP);
   dP = m_axpy(c.z * ebar[g], dilatation_dgradient(law, st, d), dP);
   store_nodal_forces(m_scale(dP, -1.0f), rest_inverse(dm_inv, t), c.x, tet_force + 4 * t);
@@ -367,7 +381,8 @@ __kernel void fem_diagonal(__global const float* restrict state, __global const 
     for (int a = 0; a < 3; ++a) {
       mat3 dF = m_zero();
       dF.m[3 * a + 0] = grads[i].x; dF.m[3 * a + 1] = grads[i].y; dF.m[3 * a + 2] = grads[i].z;
-      mat3 dP = m_add(deviatoric_dpiola(law, st, dF, c.y, b), fibre_dpiola(m_load(st + S_F), dF, fibre[t], c.w));
+      mat3 dP = deviatoric_dpiola(law, st, dF, c.y, b);
+      if (fibre[t].w > 0.0f) dP = m_add(dP, fibre_dpiola(st, dF, fibre[t].xyz));
       dP = m_axpy(c.z * m_ddot(G, dF), G, dP);
       dP = m_axpy(c.z * e, dilatation_dgradient(law, st, dF), dP);
       blocks[12 * t + 3 * i + a] = (float4)(c.x * m_vec(dP, grads[i]), 0.0f);
