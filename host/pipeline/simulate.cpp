@@ -47,12 +47,12 @@ namespace {
 // A device that cannot run the scene's solver is refused before the roles and the mesh, not after them
 // (solve_on_device refuses it too, for callers that skip this).
 void require_device_runs_solver(const Scene& scene) {
-  const SolveOptions opt = solve_options_from_scene(scene);
-  if (opt.allow_cpu_fallback || !ocl::parse_device_spec(scene.device).use_opencl) return;
-  const std::string why = device_shortfall(opt);
-  if (!why.empty())
-    throw InputError("scene " + scene.path + ": device \"" + scene.device + "\" cannot run this solve: " + why +
-                     ". Choose device \"cpu\", or set solver.allow_cpu_fallback to solve on the CPU");
+  if (!ocl::parse_device_spec(scene.device).use_opencl) return;
+  try {
+    require_device_solves(scene.device, solve_options_from_scene(scene));
+  } catch (const InputError& e) {
+    throw InputError("scene " + scene.path + ": " + e.what());
+  }
 }
 }  // namespace
 
@@ -99,11 +99,9 @@ void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hoo
   const auto t0 = std::chrono::steady_clock::now();
   const ocl::DeviceSpec device = ocl::parse_device_spec(scene.device);
   std::shared_ptr<ocl::Context> ctx;
-  if (device.use_opencl) {
-    ctx = ocl::Context::shared(device);
-    if (device_implements(solve_options_from_scene(scene))) log::info("solving on " + ctx->info().spec() + " " + ctx->info().name);
-  }
+  if (device.use_opencl) ctx = ocl::Context::shared(device);
   SolveOptions base = solve_options_from_scene(scene);
+  if (ctx && device_implements(base)) log::info("solving on " + ctx->info().spec() + " " + ctx->info().name);
   // With gravity compensated the solver's rest shape is the unloaded one, and every solve starts at
   // the CT (its equilibrium under gravity); displacements stay measured from the CT (sim.mesh).
   std::optional<Mesh> unloaded;

@@ -30,6 +30,14 @@ std::string device_shortfall(const SolveOptions& opt) {
          (ties ? " and bonded interfaces (mesh.attached_labels)" : "");
 }
 
+void require_device_solves(const std::string& device, const SolveOptions& opt) {
+  if (opt.allow_cpu_fallback) return;
+  const std::string why = device_shortfall(opt);
+  if (!why.empty())
+    throw InputError("device \"" + device + "\" cannot run this solve: " + why +
+                     ". Choose device \"cpu\", or set solver.allow_cpu_fallback to solve on the CPU");
+}
+
 SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions& opt,
                             const std::vector<Vec3>& x_start) {
   if (ctx && device_implements(opt)) {
@@ -46,10 +54,8 @@ SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions
   }
   std::string fallback;
   if (ctx) {
+    require_device_solves(ctx->info().spec(), opt);
     const std::string why = device_shortfall(opt);
-    if (!opt.allow_cpu_fallback)
-      throw InputError(ctx->info().spec() + " cannot run this solve: " + why +
-                       ". Choose device \"cpu\", or set solver.allow_cpu_fallback to solve on the CPU");
     fallback = ctx->info().spec() + ": " + why;
     static std::atomic<bool> said{false};
     if (!said.exchange(true)) log::info("solving on the CPU: " + why);

@@ -17,6 +17,11 @@ bool device_implements(const SolveOptions& opt);
 /// Why OpenCL cannot solve these options ("" when it can): one sentence naming what it does solve.
 std::string device_shortfall(const SolveOptions& opt);
 
+/// InputError when OpenCL device `device` (its spec, as the user wrote or the context names it)
+/// cannot solve these options and opt.allow_cpu_fallback is not set: the one refusal, shared by
+/// solve_on_device and the pipeline's check before the roles are built.
+void require_device_solves(const std::string& device, const SolveOptions& opt);
+
 /// Solves on `ctx` when it is given and implements the options, on the CPU without one. Given one that
 /// does not implement them: InputError naming the choice, unless opt.allow_cpu_fallback, then on the
 /// CPU, saying so once per process and in SolveResult::device_fallback. SolveResult::device is where
