@@ -17,13 +17,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <random>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "core/units.h"
 #include "mesh/mesh.h"
+#include "solve/force_field.h"
 #include "solve/solver.h"
+#include "solve/thorax_beyond_cut.h"
 #include "validate/tet_field.h"
 
 using namespace pneumo;
@@ -220,4 +224,169 @@ TEST(CutFaces, ATubeSlidingOnItsCutsIsInPlaneStrainAtTheCutAsInTheMiddle) {
 
   const TubeAnswer open = solve_tube(CutFaces::Free, p_mmhg);
   EXPECT_NEAR(open.middle_mm / stress, 1.0, 0.05) << "free: middle " << open.middle_mm << " mm, plane stress " << stress;
+}
+
+// The chest beyond a cranial cut (MeshOptions::opens_onto_thorax, solve/thorax_beyond_cut.h): the top
+// face of the tube, here all of its tissue taken as opening onto the chest, pushes into a gas spring
+// of compliance C instead of sliding.
+namespace {
+
+Mesh tube_opening_onto_chest(const Tube& t, double compliance_m3_per_pa) {
+  MeshOptions mo;
+  mo.cube_voxels = 2;
+  mo.model = MeshModel::Wall;
+  mo.cut_faces = CutFaces::Slide;
+  mo.opens_onto_thorax = [](Role r, int, float) { return r == Role::Wall; };
+  Mesh m = build_mesh(VoxelRoles{t.g, t.roles.data(), nullptr}, mo, [](Role, int) { return units::kpa_to_pa(kYoungKpa); });
+  assign_material(m, MaterialOptions{});
+  m.tet_poisson.assign(m.tets.size(), kPoisson);
+  m.thorax_compliance_m3_per_pa = compliance_m3_per_pa;
+  return m;
+}
+
+double thorax_area_m2(const Mesh& m) {
+  double a = 0.0;
+  for (const Vec3& v : m.thorax_area_m2) a += v[2];
+  return a;
+}
+
+}  // namespace
+
+TEST(CutFaces, TheTopFaceOpensOntoTheChestWithTheCutTissuesWholeArea) {
+  // The grid's z runs to the head, so the last slice is the cranial cut: its nodes are listed, not
+  // held, and their shares add up to the wall voxels the slice cuts (1 mm² each), all towards the head;
+  // the caudal cut still slides.
+  const Tube t = tube();
+  const Mesh m = tube_opening_onto_chest(t, 1e-9);
+  int64_t top_voxels = 0;
+  for (int64_t j = 0; j < kSide; ++j)
+    for (int64_t i = 0; i < kSide; ++i) top_voxels += t.roles[std::size_t(t.g.linear_index(i, j, kSlices - 1))] == Role::Wall;
+  ASSERT_GT(top_voxels, 1000);
+  EXPECT_NEAR(thorax_area_m2(m), double(top_voxels) * 1e-6, 1e-12);
+  std::set<int32_t> listed(m.thorax_node.begin(), m.thorax_node.end());
+  EXPECT_EQ(listed.size(), m.thorax_node.size());
+  for (std::size_t i = 0; i < m.thorax_node.size(); ++i) {
+    EXPECT_EQ(m.node_lattice[std::size_t(m.thorax_node[i])][2], kSlices / 2);
+    EXPECT_EQ(m.hold[std::size_t(m.thorax_node[i])], 0);
+    EXPECT_GT(m.thorax_area_m2[i][2], 0.0);
+    EXPECT_NEAR(m.thorax_area_m2[i].head<2>().norm(), 0.0, 1e-15);
+  }
+  for (int64_t n = 0; n < m.node_count(); ++n)
+    if (m.node_lattice[std::size_t(n)][2] == 0) EXPECT_EQ(m.hold[std::size_t(n)], kHoldZ);
+  EXPECT_EQ(m.stats.thorax_nodes, int64_t(m.thorax_node.size()));
+}
+
+TEST(CutFaces, TheChestsForcesAreMinusItsEnergysGradientAndItsStiffnessTheirJacobian) {
+  // The chest's gas spring and the face's shape (thorax_beyond_cut.h) with the tube's elements.
+  // At a random state (every node moved up to 0.05 mm), the whole field's forces against −∂E/∂x by
+  // central differences over the face's nodes (step 1e-8 m), and its stiffness product for a random
+  // direction against −(f(x + εp) − f(x − εp))/2ε. C is chosen so the chest's stiffness A²/C is that of
+  // the tube's own column, E A / H, so its terms are not lost beside the elements'. Tolerance 1e-5 of
+  // the largest force: differences of a smooth energy, only rounding and O(ε²) remain.
+  const Tube t = tube();
+  Mesh m = tube_opening_onto_chest(t, 1.0);
+  const double area = thorax_area_m2(m);
+  m.thorax_compliance_m3_per_pa = area * units::mm_to_m(kSlices) / units::kpa_to_pa(kYoungKpa);
+  ForceModel fm;
+  fm.material = MaterialModel::FemNeoHookean;
+  auto field = make_force_field(m, fm);
+  std::mt19937 rng(20261208u);
+  std::uniform_real_distribution<double> jitter(-0.05e-3, 0.05e-3);
+  std::vector<Vec3> x = m.rest_m;
+  for (Vec3& p : x) p += Vec3(jitter(rng), jitter(rng), jitter(rng));
+  std::vector<Vec3> f(x.size(), Vec3::Zero());
+  field->evaluate(fm, x, {}, f);
+  double scale = 0.0;
+  for (const Vec3& v : f) scale = std::max(scale, v.norm());
+  const double h = 1e-8;
+  double worst = 0.0;
+  for (int32_t n : m.thorax_node)
+    for (int a = 0; a < 3; ++a) {
+      std::vector<Vec3> xp = x, xm = x;
+      xp[std::size_t(n)][a] += h;
+      xm[std::size_t(n)][a] -= h;
+      const double grad = (field->elastic_energy(fm, xp) - field->elastic_energy(fm, xm)) / (2 * h);
+      worst = std::max(worst, std::abs(f[std::size_t(n)][a] + grad));
+    }
+  EXPECT_LT(worst, 1e-5 * scale);
+
+  field->linearize(fm, x);
+  std::vector<Vec3> dir(x.size());
+  for (Vec3& d : dir) d = Vec3(jitter(rng), jitter(rng), jitter(rng)) / 0.05e-3;
+  std::vector<Vec3> kp;
+  field->stiffness_product(dir, kp);
+  const double eps = 1e-9;
+  std::vector<Vec3> xp = x, xm = x, fp(x.size(), Vec3::Zero()), fm_(x.size(), Vec3::Zero());
+  for (std::size_t n = 0; n < x.size(); ++n) { xp[n] += eps * dir[n]; xm[n] -= eps * dir[n]; }
+  field->evaluate(fm, xp, {}, fp);
+  field->evaluate(fm, xm, {}, fm_);
+  double mismatch = 0.0, size = 0.0;
+  for (std::size_t n = 0; n < x.size(); ++n) {
+    const Vec3 fd = -(fp[n] - fm_[n]) / (2 * eps);
+    mismatch = std::max(mismatch, (kp[n] - fd).norm());
+    size = std::max(size, fd.norm());
+  }
+  EXPECT_LT(mismatch, 1e-5 * size);
+  // The diagonal blocks hold the rank-one block's own: a_i a_iᵀ / C on top of the elements'.
+  // The diagonal blocks the chest and the face add are their K's own: for a few of the face's nodes,
+  // the block K e_j read from the product with each unit direction on that node, both less the
+  // elements' (whose diagonal is the preconditioner's, not exact under the mean dilatation).
+  // Tolerance 1e-5 of the whole block: the elements' two linearisations agree to rounding of their own
+  // far larger blocks, and a wrong weight would miss by the chest's and the face's whole share.
+  Mesh without_chest = m;
+  without_chest.thorax_node.clear();
+  without_chest.thorax_area_m2.clear();
+  auto inner = make_force_field(without_chest, fm);
+  inner->linearize(fm, x);
+  std::vector<Mat3> blocks, inner_blocks;
+  field->stiffness_diagonal(blocks);
+  inner->stiffness_diagonal(inner_blocks);
+  for (std::size_t i = 0; i < m.thorax_node.size(); i += m.thorax_node.size() / 5) {
+    const std::size_t n = std::size_t(m.thorax_node[i]);
+    Mat3 column_block;
+    for (int c = 0; c < 3; ++c) {
+      std::vector<Vec3> e(x.size(), Vec3::Zero()), ke, ke_inner;
+      e[n][c] = 1.0;
+      field->stiffness_product(e, ke);
+      inner->stiffness_product(e, ke_inner);
+      column_block.col(c) = ke[n] - ke_inner[n];
+    }
+    EXPECT_GT(column_block.norm(), 1e-3 * blocks[n].norm()) << "node " << n << ": the face's terms are lost in rounding";
+    EXPECT_LT((blocks[n] - inner_blocks[n] - column_block).norm(), 1e-5 * blocks[n].norm()) << "node " << n;
+  }
+}
+
+TEST(CutFaces, ATubeOpeningOntoTheChestShortensAsTheGasSpringsClosedFormSays) {
+  // The tube under internal pressure p, its caudal cut sliding and its cranial cut pushing into the
+  // chest. Generalised plane strain is exact for the prism: one axial strain ε_z = w / H, σ_z =
+  // E ε_z + ν S with S = σ_r + σ_θ = 2 p a² / (b² − a²) (Lamé), and the end's traction is the chest's
+  // pressure, σ_z = −A w / C. So the top moves by
+  //   w = −ν S / (E/H + A/C)
+  // (pulled into the tube: the bore's pressure shortens it, and the chest's pressure falls). C free
+  // (10⁶ × E A / H) gives the open tube's −ν S H / E; C = A H / E halves it; the tube is 12 mm of 2 mm
+  // cubes. The top's w is the volume it pushed into the chest over its area. Tolerance 5 %, as for the
+  // tube's radial closed forms above (they came within 1.4 %); the three cases differ by 50 % or more.
+  const double p_mmhg = 0.12, p_pa = units::mmhg_to_pa(p_mmhg);
+  const double a = units::mm_to_m(kInnerMm), b = units::mm_to_m(kOuterMm), H = units::mm_to_m(kSlices);
+  const double E = units::kpa_to_pa(kYoungKpa), S = 2.0 * p_pa * a * a / (b * b - a * a);
+  const Tube t = tube();
+  for (double stiffness_ratio : {1e-6, 1.0, 4.0}) {   // (A/C) / (E/H)
+    SCOPED_TRACE(stiffness_ratio);
+    Mesh m = tube_opening_onto_chest(t, 1.0);
+    const double area = thorax_area_m2(m);
+    m.thorax_compliance_m3_per_pa = area * H / (E * stiffness_ratio);
+    SolveOptions so;
+    so.method = SolverMethod::Newton;
+    so.forces.material = MaterialModel::FemNeoHookean;
+    so.forces.mean_dilatation = true;
+    so.forces.pressure_pa = p_pa;
+    so.residual_tolerance = 1e-7;
+    const SolveResult r = solve(m, so);
+    ASSERT_TRUE(r.converged) << "residual " << r.residual;
+    const double w = thorax_volume_change_m3(m, r.x) / area;
+    const double expected = -kPoisson * S / (E / H + area / m.thorax_compliance_m3_per_pa);
+    std::printf("chest stiffness %g x the column's: top moved %.5f mm, closed form %.5f mm\n", stiffness_ratio, w * 1e3,
+                expected * 1e3);
+    EXPECT_NEAR(w / expected, 1.0, 0.05) << "top moved " << w * 1e3 << " mm, closed form " << expected * 1e3 << " mm";
+  }
 }

@@ -13,6 +13,15 @@ double lloyd_tet_spring_k(double young_pa, double volume_m3) {
   return 2.0 * std::sqrt(2.0) / 25.0 * young_pa * l;
 }
 
+std::vector<double> node_lloyd_stiffness(const Mesh& m) {
+  std::vector<double> node_k(std::size_t(m.node_count()), 0.0);
+  for (std::size_t t = 0; t < m.tets.size(); ++t) {
+    const double k = lloyd_tet_spring_k(m.tet_young_pa[t], m.tet_rest_volume_m3[t]);
+    for (int32_t n : m.tets[t]) node_k[std::size_t(n)] += k;
+  }
+  return node_k;
+}
+
 void assign_material(Mesh& m, const MaterialOptions& opt) {
   m.mass_kg.assign(m.node_count(), 0.0);
   m.spring_k.assign(m.springs.size(), 0.0);

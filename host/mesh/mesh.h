@@ -79,6 +79,11 @@ struct MeshOptions {
   /// is the default here: a mesh built from voxels that are no CT (a test block, a validation) has no
   /// cut; scenes default to Slide (SceneMesh::cut_faces).
   CutFaces cut_faces = CutFaces::Free;
+  /// With Slide, the cranial cut face opens onto the chest: where the tissue the CT cuts there is
+  /// viscera (the liver, the stomach under the dome), or wall for which this says true (the lungs),
+  /// the face's nodes are not held on its normal but listed in Mesh::thorax_node, for the lungs beyond
+  /// the cut (solve/thorax_beyond_cut.h), whose compliance the caller sets. Unset: every cut face slides.
+  std::function<bool(Role, int label, float hu)> opens_onto_thorax;
   /// When set, each tetrahedron's ν (Mesh::tet_poisson) is the mean of its tissue's sample points'
   /// (one tissue: its own; lung and diaphragm in one tetrahedron: between the two). Unset: the
   /// caller fills tet_poisson.
@@ -124,6 +129,7 @@ struct ContactFaces {
 struct MeshStats {
   int64_t nodes = 0, tetrahedra = 0, springs = 0, fixed_nodes = 0;
   int64_t cut_face_nodes = 0;      // nodes held on cut faces' normals only (MeshOptions::cut_faces)
+  int64_t thorax_nodes = 0;        // cranial cut-face nodes that open onto the chest (Mesh::thorax_node)
   int64_t cavity_faces = 0;        // voxel faces between wall and viscera, both sides counted
   int64_t attached_faces = 0;      // of those, the ones of an attached label (no gas), both sides
   int64_t pressure_tetrahedra = 0; // tetrahedra carrying some of them
@@ -172,6 +178,12 @@ struct Mesh {
   std::vector<int32_t> load_tet;
   std::vector<std::array<Vec3, 4>> load_c;
   ContactFaces contact;
+  // The cranial cut face where it opens onto the chest (MeshOptions::opens_onto_thorax): its nodes and
+  // each one's share of the face as an area vector out of the mesh, towards the head (m²), so that
+  // Σ thorax_area_m2[i]·u_i is the volume the face pushes into the chest (solve/thorax_beyond_cut.h).
+  std::vector<int32_t> thorax_node;
+  std::vector<Vec3> thorax_area_m2;
+  double thorax_compliance_m3_per_pa = 0;   // the lungs' beyond the cut; 0: the face is held (set by the caller)
 
   // Where it came from.
   Geometry grid;                            // the voxel grid
@@ -209,6 +221,8 @@ void assign_material(Mesh& mesh, const MaterialOptions& opt);
 
 /// Lloyd's per-tetrahedron spring constant for ν = 1/4 (§4): (2√2/25)·E·(6√2·V)^(1/3), N/m.
 double lloyd_tet_spring_k(double young_pa, double volume_m3);
+/// Each node's own stiffness (N/m): Σ over its tetrahedra of Lloyd's k for their modulus and rest volume.
+std::vector<double> node_lloyd_stiffness(const Mesh& m);
 
 /// The 4 vertex forces of pressure load l at positions x (§5): f_i = −P · cof(D_s) · c_i.
 std::array<Vec3, 4> pressure_load_forces(const Mesh& m, int64_t l, const std::vector<Vec3>& x, double pressure_pa);

@@ -208,6 +208,40 @@ bool cut_through_tissue(const VoxelRoles& roles, const std::array<int64_t, 3>& n
   return false;
 }
 
+/// Where the CT's cranial cut opens onto the chest (MeshOptions::opens_onto_thorax): each lattice node's
+/// share, per part, of the cut slice's voxel faces whose tissue opens onto it (viscera, or wall the
+/// predicate names), in voxel faces, each face split among its cube's four corners in the plane
+/// bilinearly by where its centre lies. Indexed [part][node index on the plane: n_u + (cubes_u + 1) n_w].
+std::array<std::vector<double>, 2> thorax_face_shares(const VoxelRoles& roles, const Lattice& lat, const CubeVoxels& L,
+                                                      int axis, int64_t slice, const MeshOptions& opt) {
+  const Geometry& g = roles.geometry;
+  const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+  const int64_t row = lat.cubes[u] + 1;
+  std::array<std::vector<double>, 2> share;
+  for (auto& s : share) s.assign(std::size_t(row * (lat.cubes[w] + 1)), 0.0);
+  std::array<int64_t, 3> v{};
+  v[axis] = slice;
+  for (v[w] = 0; v[w] < g.dims[w]; ++v[w])
+    for (v[u] = 0; v[u] < g.dims[u]; ++v[u]) {
+      const int64_t i = g.linear_index(v[0], v[1], v[2]);
+      const Role r = roles.role[i];
+      int p = -1;
+      if (r == Role::Viscera && opt.model == MeshModel::WallViscera) p = int(Part::Viscera);
+      else if (r == Role::Wall && opt.opens_onto_thorax(r, roles.label ? roles.label[i] : 0, roles.hu ? roles.hu[i] : 0.0f))
+        p = int(Part::Wall);
+      if (p < 0) continue;
+      // The voxel's centre in lattice units along u and w (node n sits at voxel corner n·L).
+      const double su = (double(v[u]) + 0.5) / double(L[u]), sw = (double(v[w]) + 0.5) / double(L[w]);
+      const int64_t nu = int64_t(su), nw = int64_t(sw);
+      const double fu = su - double(nu), fw = sw - double(nw);
+      share[p][std::size_t(nu + row * nw)] += (1 - fu) * (1 - fw);
+      share[p][std::size_t(nu + 1 + row * nw)] += fu * (1 - fw);
+      share[p][std::size_t(nu + row * (nw + 1))] += (1 - fu) * fw;
+      share[p][std::size_t(nu + 1 + row * (nw + 1))] += fu * fw;
+    }
+  return share;
+}
+
 /// The face of voxel (i,j,k) on its `side` (±1) along `axis`: its centre in index space, and in world
 /// metres with its area vector (m²) out of the voxel.
 struct VoxelFace {
@@ -564,7 +598,8 @@ MeshFootprint estimate_mesh_footprint(const VoxelRoles& roles, const MeshOptions
                            6 * sizeof(std::pair<int64_t, int64_t>);   // the edge sort, reserved exactly
   const uint64_t per_node =
       2 * (sizeof(Vec3) + sizeof(Part) + sizeof(uint8_t) + sizeof(std::array<int32_t, 3>) + sizeof(double)) +
-      sizeof(uint8_t);   // node_attached, sized once
+      sizeof(uint8_t) +   // node_attached, sized once
+      (opt.opens_onto_thorax ? 2 * (sizeof(int32_t) + sizeof(Vec3)) : 0);   // thorax_node, thorax_area_m2 (a bound)
   const uint64_t per_spring = 2 * (sizeof(std::array<int32_t, 2>) + 3 * sizeof(double));
   const uint64_t per_contact_face = 4 * (sizeof(int32_t) + sizeof(std::array<double, 4>) + sizeof(Vec3) + sizeof(Part));
   const uint64_t per_load = 2 * (sizeof(int32_t) + 2 * sizeof(std::array<Vec3, 4>) + sizeof(int64_t));
@@ -615,7 +650,7 @@ uint64_t mesh_bytes(const Mesh& m) {
          held(m.tet_part) + held(m.tet_label) + held(m.tet_fraction) + held(m.tet_cube) + held(m.tet_rest_volume_m3) +
          held(m.tet_young_pa) + held(m.tet_poisson) + held(m.tet_fibre) + held(m.tet_fibre_k1_pa) + held(m.tet_springs) + held(m.springs) + held(m.spring_rest_m) +
          held(m.spring_k) + held(m.spring_c) + held(m.load_tet) + held(m.load_c) + held(c.tet) + held(c.w) + held(c.c) +
-         held(c.part) + held(c.fixed_centre_m) + held(c.fixed_area_m2);
+         held(c.part) + held(c.fixed_centre_m) + held(c.fixed_area_m2) + held(m.thorax_node) + held(m.thorax_area_m2);
 }
 
 Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const std::function<double(Role, int)>& young_pa_for) {
@@ -735,7 +770,18 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
       // than half a cube.
       const struct { int64_t slice, plane; } faces[2] = {{first, (2 * first + L[axis] - 1) / (2 * L[axis])},
                                                          {last, (2 * (last + 1) + L[axis]) / (2 * L[axis])}};
-      for (const auto& face : faces) {
+      for (int side = 0; side < 2; ++side) {
+        const auto& face = faces[side];
+        // The face towards the head (world +z, RAS) may open onto the chest (MeshOptions::opens_onto_thorax).
+        const bool cranial = bit == kHoldZ && opt.opens_onto_thorax && (g.direction(2, axis) > 0) == (side == 1);
+        std::array<std::vector<double>, 2> shares;
+        Vec3 voxel_face_m2 = Vec3::Zero();   // one voxel face of the slice, out of the mesh
+        if (cranial) {
+          shares = thorax_face_shares(roles, lat, L, axis, face.slice, opt);
+          const int64_t mid[3] = {g.dims[0] / 2, g.dims[1] / 2, g.dims[2] / 2};
+          const int64_t at[3] = {axis == 0 ? face.slice : mid[0], axis == 1 ? face.slice : mid[1], axis == 2 ? face.slice : mid[2]};
+          voxel_face_m2 = voxel_face(g, at[0], at[1], at[2], axis, side == 1 ? 1 : -1).area_m2;
+        }
         std::array<int64_t, 3> n{};
         n[axis] = face.plane;
         const int u = (axis + 1) % 3, w = (axis + 2) % 3;
@@ -744,8 +790,17 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
             const int64_t ni = lat.node_index(n[0], n[1], n[2]);
             if (node_id[0][ni] < 0 && node_id[1][ni] < 0) continue;
             if (!cut_through_tissue(roles, n, axis, face.slice, L, with_viscera)) continue;
-            for (int p = 0; p < kParts; ++p)
-              if (node_id[p][ni] >= 0) m.hold[node_id[p][ni]] |= bit;
+            for (int p = 0; p < kParts; ++p) {
+              const int32_t id = node_id[p][ni];
+              if (id < 0) continue;
+              const double share = cranial ? shares[p][std::size_t(n[u] + (lat.cubes[u] + 1) * n[w])] : 0.0;
+              if (share > 0.0 && m.hold[id] != kHoldAll) {
+                m.thorax_node.push_back(id);
+                m.thorax_area_m2.push_back(share * voxel_face_m2);
+              } else {
+                m.hold[id] |= bit;
+              }
+            }
           }
       }
     }
@@ -785,6 +840,7 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
     m.stats.cut_face_nodes += m.hold[i] != 0 && m.hold[i] != kHoldAll;
     ++(m.node_part[i] == Part::Wall ? m.stats.wall_nodes : m.stats.viscera_nodes);
   }
+  m.stats.thorax_nodes = int64_t(m.thorax_node.size());
   return m;
 }
 

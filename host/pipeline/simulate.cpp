@@ -23,6 +23,7 @@
 #include "solve/gravity_compensation.h"
 #include "solve/solvable.h"
 #include "solve/solve_on_device.h"
+#include "solve/thorax_beyond_cut.h"
 
 namespace pneumo {
 
@@ -79,6 +80,7 @@ Simulation prepare_simulation(const Scene& scene, bool keep_inputs) {
      << s.cavity_faces << " cavity faces, " << s.fixed_nodes << " fixed nodes, " << s.doubled_cubes
      << " doubled cubes";
   if (s.cut_face_nodes > 0) os << ", " << s.cut_face_nodes << " nodes sliding on the CT's cut faces";
+  if (s.thorax_nodes > 0) os << ", " << s.thorax_nodes << " opening onto the chest";
   log::info(os.str());
   // Before starting a device: nothing free, or a part the load would carry away.
   check_solvable(sim.mesh, solve_options_from_scene(scene), "scene " + scene.path);
@@ -261,6 +263,15 @@ nlohmann::json simulation_metrics(const Scene& scene, const Simulation& sim) {
   j["pressure_tetrahedra"] = s.pressure_tetrahedra;
   j["fixed_nodes"] = s.fixed_nodes;
   j["cut_face_nodes"] = s.cut_face_nodes;
+  if (!sim.mesh.thorax_node.empty()) {
+    // The chest beyond the cranial cut (solve/thorax_beyond_cut.h): what the cut face pushed into it
+    // and the pleural pressure that rose to meet it.
+    const double dv_m3 = thorax_volume_change_m3(sim.mesh, r.x);
+    j["thorax_nodes"] = s.thorax_nodes;
+    j["thorax_compliance_l_per_cmh2o"] = sim.mesh.thorax_compliance_m3_per_pa / units::l_per_cmh2o_to_m3_per_pa(1.0);
+    j["thorax_volume_change_ml"] = dv_m3 * 1e6;
+    j["thorax_pressure_cmh2o"] = dv_m3 / sim.mesh.thorax_compliance_m3_per_pa / units::kPaPerCmH2O;
+  }
   j["wall_cubes"] = s.wall_cubes;
   j["viscera_cubes"] = s.viscera_cubes;
   j["doubled_cubes"] = s.doubled_cubes;

@@ -101,8 +101,9 @@ ScanCoverage scan_coverage(const RoleVolume& rv, const std::map<int, std::string
       if (compartment_of(s) == Compartment::Peritoneal) {
         c.warnings.push_back("the top slice cuts the " + words(s) +
                              ": the cavity's roof (the diaphragm) lies above the scan; by default the cut face "
-                             "slides in its plane (mesh.cut_faces), a diaphragm that neither rises nor gives: "
-                             "trust the answer less near the top slice");
+                             "slides in its plane (mesh.cut_faces), a diaphragm that neither rises nor gives "
+                             "(material.thorax_compliance_l_per_cmh2o lets it move into the lungs): trust the "
+                             "answer less near the top slice");
         break;
       }
   if (!names.empty() && !c.pelvis_in_view && c.bottom.cuts_body)

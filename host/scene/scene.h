@@ -69,6 +69,10 @@ struct SceneMaterial {
   std::optional<double> lung_young_kpa = 1.0;   // null = off (the wall's E)
   double lung_poisson_ratio = 0.40;
   double lung_hu_max = -500.0;   // the body's own threshold: the skin's partial-volume rim is never lung
+  // The lungs beyond the CT's cranial cut, a gas spring of this compliance less the lungs' share in view
+  // (solve/thorax_beyond_cut.h); 0.12 is the anaesthetised lung of lung_young_kpa. null (the default,
+  // docs/fidelity.md "The chest beyond the cut"): the cut slides like the others.
+  std::optional<double> thorax_compliance_l_per_cmh2o;
   double damping_ratio = 0.4;     // ζ, Nimura (§4)
   double spring_scale = 1.0;      // as published; 0.925 matches the lattice to E (§4)
   SpringModel spring_model = SpringModel::Nonlinear;  // rotation-invariant (§5)
@@ -203,6 +207,10 @@ struct Scene {
   /// Whether a voxel of this role, label and HU is lung tissue of the wall: aerated wall, unlabelled
   /// or of a label named lung (roles.lung_ids), with roles.compliant_lungs and lung_young_kpa set.
   bool is_lung_voxel(Role role, int label, float hu) const;
+  /// The compliance (m³/Pa) of the lungs beyond the CT's cranial cut when `lung_in_view_m3` of them
+  /// lie inside it: material.thorax_compliance_l_per_cmh2o times the share of the lungs' volume (their
+  /// bulk modulus times that compliance) not in view; 0 when off or when the CT shows them whole.
+  double thorax_compliance_m3_per_pa(double lung_in_view_m3) const;
   /// Whether a label takes the liver's vascular compliance: viscera of a label named liver
   /// (roles.liver_ids), with liver_volume_loss set, no E of its own in label_young_kpa and finite
   /// elements (the springs' ν is fixed).

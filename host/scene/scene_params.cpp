@@ -230,6 +230,13 @@ const Table<SceneMaterial>& material_table() {
       {"lung_hu_max", &SceneMaterial::lung_hu_max, "HU", in(-1024, 3071),
        "With compliant_lungs, wall voxels at or below this are lung (-500, the body mask's threshold: aerated lung "
        "lies below at any inspiration, and the skin's partial-volume rim, body only above it, is never lung)."},
+      {"thorax_compliance_l_per_cmh2o", &SceneMaterial::thorax_compliance_l_per_cmh2o, "L/cmH2O", in(1e-3, 10),
+       "With mesh.cut_faces \"slide\": where the CT's cranial cut face cuts viscera or lung, the chest goes on "
+       "beyond it. That face is not held but moves into a gas spring as a whole: one pleural pressure ΔV/C over "
+       "the face, C this compliance times the share of the lungs not in view (their volume: lung_young_kpa's bulk "
+       "modulus times C), and the face's shape held as the sliding cut holds it. 0.12 is the anaesthetised adult "
+       "lung's, as lung_young_kpa. null (the default): the cranial cut slides like the others (docs/fidelity.md, "
+       "the chest beyond the cut)."},
       {"damping_ratio", &SceneMaterial::damping_ratio, "", in(0, 10),
        "ζ: each spring's damper c = 2ζ√(m k) (§4; Nimura 0.4)."},
       {"spring_scale", &SceneMaterial::spring_scale, "", in(0.01, 10),

@@ -71,6 +71,15 @@ bool Scene::is_lung_voxel(Role role, int label, float hu) const {
   return label == 0 || std::find(roles.lung_ids.begin(), roles.lung_ids.end(), label) != roles.lung_ids.end();
 }
 
+double Scene::thorax_compliance_m3_per_pa(double lung_in_view_m3) const {
+  if (!material.thorax_compliance_l_per_cmh2o) return 0.0;
+  const double compliance = units::l_per_cmh2o_to_m3_per_pa(*material.thorax_compliance_l_per_cmh2o);
+  if (!(lung_in_view_m3 > 0.0) || !material.lung_young_kpa) return compliance;
+  // V = K C: the lungs' volume from their bulk modulus K = E / (3 (1 − 2ν)) and the same compliance.
+  const double bulk_pa = units::kpa_to_pa(*material.lung_young_kpa) / (3.0 * (1.0 - 2.0 * material.lung_poisson_ratio));
+  return compliance * std::max(0.0, 1.0 - lung_in_view_m3 / (bulk_pa * compliance));
+}
+
 double Scene::poisson_for(Role role, int label) const {
   for (const LabelYoung& l : material.label_young_kpa)
     if (l.label == label && l.poisson_ratio) return *l.poisson_ratio;

@@ -5,6 +5,7 @@
 
 #include "solve/contact.h"
 #include "solve/interface_tie.h"
+#include "solve/thorax_beyond_cut.h"
 #include "solve/newton_linear_solver.h"
 
 namespace pneumo {
@@ -23,7 +24,7 @@ std::unique_ptr<ForceField> make_material_field(const Mesh& m, const ForceModel&
 std::unique_ptr<NewtonLinearSolver> ForceField::device_linear_solver(const std::vector<TiedPair>&) { return nullptr; }
 
 std::unique_ptr<ForceField> make_force_field(const Mesh& m, const ForceModel& model) {
-  return with_interface_tie(m, model, with_contact(m, model, make_material_field(m, model)));
+  return with_thorax_beyond_cut(m, with_interface_tie(m, model, with_contact(m, model, make_material_field(m, model))));
 }
 
 }  // namespace pneumo

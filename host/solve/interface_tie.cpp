@@ -82,11 +82,7 @@ class TiedForceField final : public ForceField {
 }  // namespace
 
 std::vector<TiedPair> interface_pairs(const Mesh& m, bool attached_only) {
-  std::vector<double> node_k(m.node_count(), 0.0);
-  for (std::size_t t = 0; t < m.tets.size(); ++t) {
-    const double k = lloyd_tet_spring_k(m.tet_young_pa[t], m.tet_rest_volume_m3[t]);
-    for (int32_t n : m.tets[t]) node_k[n] += k;
-  }
+  const std::vector<double> node_k = node_lloyd_stiffness(m);
   // Nodes sorted by lattice point, then part: a wall node followed by a viscera node at the same point is a pair.
   std::vector<int32_t> order(m.node_count());
   for (int32_t n = 0; n < int32_t(order.size()); ++n) order[n] = n;

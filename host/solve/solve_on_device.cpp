@@ -9,6 +9,7 @@
 #include "solve/force_field.h"
 #include "solve/interface_tie.h"
 #include "solve/solver_cl.h"
+#include "solve/thorax_beyond_cut.h"
 
 namespace pneumo {
 
@@ -30,23 +31,38 @@ std::string device_shortfall(const SolveOptions& opt) {
          (ties ? " and bonded interfaces (mesh.attached_labels)" : "");
 }
 
+namespace {
+[[noreturn]] void refuse_device(const std::string& device, const std::string& why) {
+  throw InputError("device \"" + device + "\" cannot run this solve: " + why +
+                   ". Choose device \"cpu\", or set solver.allow_cpu_fallback to solve on the CPU");
+}
+}  // namespace
+
 void require_device_solves(const std::string& device, const SolveOptions& opt) {
   if (opt.allow_cpu_fallback) return;
   const std::string why = device_shortfall(opt);
-  if (!why.empty())
-    throw InputError("device \"" + device + "\" cannot run this solve: " + why +
-                     ". Choose device \"cpu\", or set solver.allow_cpu_fallback to solve on the CPU");
+  if (!why.empty()) refuse_device(device, why);
 }
+
+namespace {
+/// Why OpenCL cannot solve on this mesh what it implements for the options ("" when it can): the
+/// springs' device schemes hold no chest beyond a cut (thorax_beyond_cut.h), which only the mesh knows.
+std::string mesh_shortfall(const Mesh& m, const SolveOptions& opt) {
+  if (opt.forces.material != MaterialModel::Msd || m.thorax_node.empty()) return "";
+  return "the springs on OpenCL have no chest beyond the CT's cranial cut (material.thorax_compliance_l_per_cmh2o "
+         "0 holds the cut instead)";
+}
+}  // namespace
 
 SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions& opt,
                             const std::vector<Vec3>& x_start) {
-  if (ctx && device_implements(opt)) {
+  if (ctx && device_implements(opt) && mesh_shortfall(m, opt).empty()) {
     SolveResult r;
     if (opt.method != SolverMethod::Newton) {
       r = solve_opencl(*ctx, m, opt, x_start);
     } else {
-      const std::unique_ptr<ForceField> field =
-          with_interface_tie(m, opt.forces, with_contact(m, opt.forces, make_fem_force_field_cl(*ctx, m, opt.forces.material)));
+      const std::unique_ptr<ForceField> field = with_thorax_beyond_cut(
+          m, with_interface_tie(m, opt.forces, with_contact(m, opt.forces, make_fem_force_field_cl(*ctx, m, opt.forces.material))));
       r = solve_newton_on(m, opt, *field, x_start);
     }
     r.device = ctx->info().spec() + " " + ctx->info().name;
@@ -54,8 +70,8 @@ SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions
   }
   std::string fallback;
   if (ctx) {
-    require_device_solves(ctx->info().spec(), opt);
-    const std::string why = device_shortfall(opt);
+    const std::string why = device_implements(opt) ? mesh_shortfall(m, opt) : device_shortfall(opt);
+    if (!opt.allow_cpu_fallback) refuse_device(ctx->info().spec(), why);
     fallback = ctx->info().spec() + ": " + why;
     static std::atomic<bool> said{false};
     if (!said.exchange(true)) log::info("solving on the CPU: " + why);
