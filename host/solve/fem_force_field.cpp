@@ -86,6 +86,9 @@ class FemForceField final : public ForceField {
 
   void linearize(const ForceModel& model, const std::vector<Vec3>& x) override {
     update_states(model, x);
+    linear_x_ = x;
+    linear_model_ = model;
+    linear_version_ = states_version_;
     if (stiffness_ == FemStiffness::MatrixFree || assembled_current_) return;
     if (!assembly_) {
       assembly_ = FemStiffnessAssembly::within(m_, *groups_, kAssembledBudgetBytes);
@@ -103,6 +106,7 @@ class FemForceField final : public ForceField {
   }
 
   void stiffness_product(const std::vector<Vec3>& p, std::vector<Vec3>& kp) override {
+    at_linearization();
     if (stiffness_ == FemStiffness::Assembled && assembled_current_) return assembly_->multiply(p, kp);
     const int64_t T = int64_t(m_.tets.size()), N = m_.node_count();
     dF_.resize(T);
@@ -133,6 +137,7 @@ class FemForceField final : public ForceField {
     // dilatation (the cube coupling left out: this is only the preconditioner).
     // The blocks of a chunk of tetrahedra on every thread, then summed into the nodes in tetrahedron
     // order on one: the same additions in the same order as a plain loop, so the same numbers.
+    at_linearization();
     blocks.assign(m_.node_count(), Mat3::Zero());
     const int64_t T = int64_t(m_.tets.size());
     constexpr int64_t kChunk = 1 << 16;
@@ -205,6 +210,7 @@ class FemForceField final : public ForceField {
       states_x_.clear();
     }
     if (model.stiffening == states_stiffening_ && x == states_x_) return;
+    ++states_version_;
     assembled_current_ = false;
     states_x_ = x;
     states_stiffening_ = model.stiffening;
@@ -221,6 +227,12 @@ class FemForceField final : public ForceField {
     }
     // An inverted neo-Hookean element has no dilatation: NaN reaches its forces and the solver.
     group_average([&](int32_t t) { return state_[t].valid ? state_[t].e : NAN; }, ebar_);
+  }
+
+  // K is the stiffness at the last linearisation (force_field.h), whatever was evaluated since: a
+  // line search between linearize and the products moves the states, which are then put back.
+  void at_linearization() {
+    if (linear_version_ >= 0 && states_version_ != linear_version_) linearize(linear_model_, std::vector<Vec3>(linear_x_));
   }
 
   // out[g] = Σ_t w_t q(t) / Λ_g over the tetrahedra of group g (0 for a group without volumetric stiffness).
@@ -253,6 +265,10 @@ class FemForceField final : public ForceField {
   std::vector<Vec3> tet_f_, load_f_;
   std::vector<Vec3> states_x_;        // the positions state_ and ebar_ belong to
   double states_stiffening_ = NAN;
+  int64_t states_version_ = 0;        // counts the states computed
+  std::vector<Vec3> linear_x_;        // the last linearisation's point, model and states' version
+  ForceModel linear_model_;
+  int64_t linear_version_ = -1;
   int64_t evaluations_ = 0;
 };
 

@@ -118,7 +118,12 @@ class ClFemForceField final : public ForceField {
     return e;
   }
 
-  void linearize(const ForceModel& model, const std::vector<Vec3>& x) override { update_states(model, x); }
+  void linearize(const ForceModel& model, const std::vector<Vec3>& x) override {
+    update_states(model, x);
+    linear_x_ = x;
+    linear_model_ = model;
+    linear_version_ = states_version_;
+  }
 
   void stiffness_product(const std::vector<Vec3>& p, std::vector<Vec3>& kp) override {
     ctx_.queue().enqueueWriteBuffer(p_, CL_TRUE, 0, N_ * sizeof(cl_float4), to_float4(p).data());
@@ -135,6 +140,7 @@ class ClFemForceField final : public ForceField {
 
   // kp = K p on device buffers, at the last linearisation.
   void product(const cl::Buffer& p, cl::Buffer& kp) {
+    at_linearization();
     auto& q = ctx_.queue();
     if (T_ > 0) {
       ocl::set_args(k_dF_, p, tets_buf_, dm_inv_, state_, law_int(), cl_int(T_), dF_);
@@ -150,6 +156,7 @@ class ClFemForceField final : public ForceField {
   }
 
   void stiffness_diagonal(std::vector<Mat3>& blocks) override {
+    at_linearization();
     auto& q = ctx_.queue();
     if (T_ > 0) {
       ocl::set_args(k_diagonal_, state_, dm_inv_, consts_, fibre_, law_int(), float(b_), cl_int(T_), blocks_);
@@ -201,6 +208,12 @@ class ClFemForceField final : public ForceField {
     debar_ = cl::Buffer(ctx_.context(), CL_MEM_READ_WRITE, bytes);
   }
 
+  // K at the last linearisation (force_field.h), as the CPU field keeps it: states moved since by an
+  // evaluation are put back first.
+  void at_linearization() {
+    if (linear_version_ >= 0 && states_version_ != linear_version_) linearize(linear_model_, std::vector<Vec3>(linear_x_));
+  }
+
   // The states at x on the device (kept with x, as the CPU field keeps its own).
   void update_states(const ForceModel& model, const std::vector<Vec3>& x) {
     if (fem_law_of(model.material) != law_)
@@ -210,6 +223,7 @@ class ClFemForceField final : public ForceField {
       states_x_.clear();
     }
     if (model.stiffening == b_ && x == states_x_) return;
+    ++states_version_;
     states_x_ = x;
     b_ = model.stiffening;
     std::vector<Vec3> u(N_);
@@ -235,6 +249,10 @@ class ClFemForceField final : public ForceField {
   cl::Kernel k_states_, k_average_, k_forces_, k_dF_, k_dforces_, k_diagonal_, k_gather_, k_gather_diagonal_, k_load_;
   std::vector<Vec3> states_x_;
   double b_ = NAN;
+  int64_t states_version_ = 0;        // counts the states computed
+  std::vector<Vec3> linear_x_;        // the last linearisation's point, model and states' version
+  ForceModel linear_model_;
+  int64_t linear_version_ = -1;
   int64_t evaluations_ = 0;
 };
 
