@@ -39,7 +39,7 @@ struct LawCase {
 };
 const LawCase kLaws[] = {{FemLaw::Corotational, 0.0, "corotational"},
                          {FemLaw::NeoHookean, 0.0, "neo-Hookean"},
-                         {FemLaw::NeoHookean, 4.0, "Demiray b=4"}};
+                         {FemLaw::NeoHookean, 4.0, "Demiray b=4"}, {FemLaw::NeoHookean, 10.0, "Demiray b=10"}};
 
 TEST(FemElement, PolarDecompositionIsARotationTimesASymmetricStretch) {
   // Compared: R S against F, RᵀR against I, det R against +1 and S against Sᵀ, for random F and for

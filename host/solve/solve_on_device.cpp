@@ -54,6 +54,11 @@ std::string mesh_shortfall(const Mesh& m, const SolveOptions& opt) {
 }
 }  // namespace
 
+std::unique_ptr<ForceField> make_device_force_field(ocl::Context& ctx, const Mesh& m, const ForceModel& model) {
+  return with_thorax_beyond_cut(
+      m, with_interface_tie(m, model, with_contact(m, model, make_fem_force_field_cl(ctx, m, model.material))));
+}
+
 SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions& opt,
                             const std::vector<Vec3>& x_start) {
   if (ctx && device_implements(opt) && mesh_shortfall(m, opt).empty()) {
@@ -61,8 +66,7 @@ SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions
     if (opt.method != SolverMethod::Newton) {
       r = solve_opencl(*ctx, m, opt, x_start);
     } else {
-      const std::unique_ptr<ForceField> field = with_thorax_beyond_cut(
-          m, with_interface_tie(m, opt.forces, with_contact(m, opt.forces, make_fem_force_field_cl(*ctx, m, opt.forces.material))));
+      const std::unique_ptr<ForceField> field = make_device_force_field(*ctx, m, opt.forces);
       r = solve_newton_on(m, opt, *field, x_start);
     }
     r.device = ctx->info().spec() + " " + ctx->info().name;

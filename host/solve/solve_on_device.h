@@ -1,6 +1,7 @@
 #pragma once
 // The one entry through which the pipeline and the benchmarks solve: the device is chosen here,
 // not by each caller. A new back end is a new case here.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,11 @@ std::string device_shortfall(const SolveOptions& opt);
 /// cannot solve these options and opt.allow_cpu_fallback is not set: the one refusal, shared by
 /// solve_on_device and the pipeline's check before the roles are built.
 void require_device_solves(const std::string& device, const SolveOptions& opt);
+
+/// The force field a device's Newton runs on: the finite elements on `ctx` (fem_force_field_cl.h) with
+/// contact, the interface bond and the chest beyond the cut where `model` and m have them, wrapped
+/// exactly as make_force_field wraps the host's. Finite-element models only.
+std::unique_ptr<ForceField> make_device_force_field(ocl::Context& ctx, const Mesh& m, const ForceModel& model);
 
 /// Solves on `ctx` when it is given and implements the options, on the CPU without one. Given one that
 /// does not implement them: InputError naming the choice, unless opt.allow_cpu_fallback, then on the
