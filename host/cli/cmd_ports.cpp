@@ -6,6 +6,7 @@
 #include "cl/cl_runtime.h"
 #include "cli/commands.h"
 #include "cli/device_option.h"
+#include "cli/gl_backend_option.h"
 #include "core/atomic_file.h"
 #include "core/output_lock.h"
 #include "pipeline/ports_run.h"
@@ -34,7 +35,7 @@ Run add_ports(CLI::App& app) {
   cmd->add_option("--fov-deg", o->fov_deg, "The scope's field of view for the visibility term (degrees)");
   cmd->add_option("--size", o->width, "Width of the heat map (pixels; height 3/4 of it)");
   add_device_option(cmd, o->device, "The solve's device when one is needed (overrides the scene's)");
-  cmd->add_option("--backend", o->backend, "Offscreen OpenGL for the heat map: auto, egl-device, egl-surfaceless or osmesa");
+  add_gl_backend_option(cmd, o->backend, "the heat map");
   cmd->add_flag("--cpu", o->cpu, "Render the heat map with the CPU reference ray caster");
   cmd->add_flag("--json", o->json, "Print the ranked table (ports.json) on standard output");
   cmd->add_flag("--force", o->force, "Replace the ports.json of an earlier ranking in --out");

@@ -2,6 +2,7 @@
 #include <memory>
 
 #include "cli/commands.h"
+#include "cli/gl_backend_option.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/output_lock.h"
@@ -20,7 +21,7 @@ Run add_render(CLI::App& app) {
   cmd->add_option("--out", o->out,
                   "Output folder; renders its deformed_ct.nii.gz (from simulate) when present, else the scene's CT")
       ->required();
-  cmd->add_option("--backend", o->backend, "Offscreen OpenGL: auto, egl-device, egl-surfaceless or osmesa");
+  add_gl_backend_option(cmd, o->backend, "the views");
   cmd->add_flag("--cpu", o->cpu, "Render with the CPU reference ray caster instead of OpenGL (slow)");
   cmd->add_flag("--force", o->force, "Replace the views of an earlier render in --out");
   return [=] {

@@ -3,6 +3,7 @@
 #include "cl/cl_runtime.h"
 #include "cli/commands.h"
 #include "cli/device_option.h"
+#include "cli/gl_backend_option.h"
 #include "cli/scene_inputs_options.h"
 #include "core/output_lock.h"
 #include "pipeline/run.h"
@@ -22,7 +23,7 @@ Run add_run(CLI::App& app) {
   add_scene_source_options(cmd, o->source);
   cmd->add_option("--out", o->out, "Output folder")->required();
   add_device_option(cmd, o->device, "Overrides the scene's device");
-  cmd->add_option("--backend", o->backend, "Offscreen OpenGL: auto, egl-device, egl-surfaceless or osmesa");
+  add_gl_backend_option(cmd, o->backend, "the views");
   cmd->add_flag("--force", o->force, "Replace the results of an earlier run in --out");
   cmd->add_flag("--resume", o->resume, "Continue an interrupted run in --out from its checkpoint.bin");
   cmd->add_option("--timelapse", o->timelapse,

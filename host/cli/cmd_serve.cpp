@@ -1,6 +1,7 @@
 #include <memory>
 
 #include "cli/commands.h"
+#include "cli/gl_backend_option.h"
 #include "render/gl_context.h"
 #include "serve/http_server.h"
 
@@ -19,7 +20,7 @@ Run add_serve(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--out", o->serve.out_dir, "Folder for the plans the page saves and their reports")
       ->capture_default_str();
-  cmd->add_option("--backend", o->backend, "Offscreen OpenGL: auto, egl-device, egl-surfaceless or osmesa");
+  add_gl_backend_option(cmd, o->backend, "the views");
   return [=] {
     serve::ServeOptions opt = o->serve;
     opt.backend = parse_gl_backend(o->backend);
