@@ -42,6 +42,15 @@ std::vector<uint8_t> fibrous_tets(const Mesh& m, const VoxelRoles& roles, const 
   return fibrous;
 }
 
+/// The volume (m³) of the voxels the scene's material takes for lung (Scene::is_lung_voxel).
+double lung_volume_m3(const VoxelRoles& roles, const Scene& scene) {
+  const Geometry& g = roles.geometry;
+  int64_t n = 0;
+  for (int64_t v = 0; v < g.voxel_count(); ++v)
+    n += scene.is_lung_voxel(roles.role[v], roles.label ? roles.label[v] : 0, roles.hu ? roles.hu[v] : 0.0f);
+  return double(n) * g.spacing_mm.prod() * 1e-9;
+}
+
 RoleInputNames input_names(const Scene& s) {
   RoleInputNames n;
   if (!s.path.empty()) n.scene = s.path;
@@ -79,17 +88,6 @@ VoxelRoles voxel_roles_of(const RoleVolume& roles) {
   return v;
 }
 
-namespace {
-/// The volume (m³) of the voxels the scene's material takes for lung (Scene::is_lung_voxel).
-double lung_volume_m3(const VoxelRoles& roles, const Scene& scene) {
-  const Geometry& g = roles.geometry;
-  int64_t n = 0;
-  for (int64_t v = 0; v < g.voxel_count(); ++v)
-    n += scene.is_lung_voxel(roles.role[v], roles.label ? roles.label[v] : 0, roles.hu ? roles.hu[v] : 0.0f);
-  return double(n) * g.spacing_mm.prod() * 1e-9;
-}
-}  // namespace
-
 Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene, bool to_solve) {
   MeshOptions opt;
   opt.cube_voxels = cube_voxels_for(scene.mesh, roles.geometry);
@@ -104,7 +102,12 @@ Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene, bool to_solve
     opt.reserve_bytes_per_tet = solver.per_tet;
   }
   opt.poisson_for = [&](Role r, int label, float hu) { return scene.poisson_for(r, label, hu); };
-  if (scene.material.thorax_compliance_l_per_cmh2o && opt.cut_faces == CutFaces::Slide)
+  // The chest beyond the cranial cut, when asked for and some of the lungs lie beyond it: a CT that
+  // shows them whole leaves none of their compliance there, and its cut slides like the others.
+  const double thorax_compliance = scene.material.thorax_compliance_l_per_cmh2o && opt.cut_faces == CutFaces::Slide
+                                       ? scene.thorax_compliance_m3_per_pa(lung_volume_m3(roles, scene))
+                                       : 0.0;
+  if (thorax_compliance > 0.0)
     opt.opens_onto_thorax = [&](Role r, int label, float hu) { return scene.is_lung_voxel(r, label, hu); };
   Mesh m = build_mesh(roles, opt,
                       VoxelYoungFn([&](Role r, int label, float hu) { return scene.young_kpa_for(r, label, hu) * 1e3; }));
@@ -113,7 +116,7 @@ Mesh build_scene_mesh(const VoxelRoles& roles, const Scene& scene, bool to_solve
   mat.damping_ratio = scene.material.damping_ratio;
   mat.spring_scale = scene.material.spring_scale;
   assign_material(m, mat);
-  if (!m.thorax_node.empty()) m.thorax_compliance_m3_per_pa = scene.thorax_compliance_m3_per_pa(lung_volume_m3(roles, scene));
+  if (!m.thorax_node.empty()) m.thorax_compliance_m3_per_pa = thorax_compliance;
   if (scene.material.wall_fibre_stiffness > 0.0 && scene.material.model != MaterialModel::Msd)
     assign_wall_fibres(m, fibrous_tets(m, roles, scene), scene.material.wall_fibre_stiffness,
                       scene.material.wall_fibre_exponent);
