@@ -774,14 +774,10 @@ Mesh build_mesh(const VoxelRoles& roles, const MeshOptions& opt, const VoxelYoun
         const auto& face = faces[side];
         // The face towards the head (world +z, RAS) may open onto the chest (MeshOptions::opens_onto_thorax).
         const bool cranial = bit == kHoldZ && opt.opens_onto_thorax && (g.direction(2, axis) > 0) == (side == 1);
-        std::array<std::vector<double>, 2> shares;
-        Vec3 voxel_face_m2 = Vec3::Zero();   // one voxel face of the slice, out of the mesh
-        if (cranial) {
-          shares = thorax_face_shares(roles, lat, L, axis, face.slice, opt);
-          const int64_t mid[3] = {g.dims[0] / 2, g.dims[1] / 2, g.dims[2] / 2};
-          const int64_t at[3] = {axis == 0 ? face.slice : mid[0], axis == 1 ? face.slice : mid[1], axis == 2 ? face.slice : mid[2]};
-          voxel_face_m2 = voxel_face(g, at[0], at[1], at[2], axis, side == 1 ? 1 : -1).area_m2;
-        }
+        const std::array<std::vector<double>, 2> shares =
+            cranial ? thorax_face_shares(roles, lat, L, axis, face.slice, opt) : std::array<std::vector<double>, 2>{};
+        // One voxel face normal to the axis, out of the mesh: the same everywhere on an affine grid.
+        const Vec3 voxel_face_m2 = voxel_face(g, 0, 0, 0, axis, side == 1 ? 1 : -1).area_m2;
         std::array<int64_t, 3> n{};
         n[axis] = face.plane;
         const int u = (axis + 1) % 3, w = (axis + 2) % 3;

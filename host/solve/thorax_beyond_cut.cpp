@@ -40,11 +40,11 @@ class ThoraxForceField final : public ForceField {
   void evaluate(const ForceModel& model, const std::vector<Vec3>& x, const std::vector<Vec3>& v,
                 std::vector<Vec3>& f) override {
     inner_->evaluate(model, x, v, f);
-    add_product(displacements(x), f, -1.0);
+    add_product(x, &m_.rest_m, f, -1.0);
   }
 
   double elastic_energy(const ForceModel& model, const std::vector<Vec3>& x) override {
-    const std::vector<double> s = normal_displacements(displacements(x));
+    const std::vector<double> s = normal_components(x, &m_.rest_m);
     const double mean = weighted_mean(s);
     double face = 0.0;
     for (std::size_t i = 0; i < s.size(); ++i) face += k_[i] * (s[i] - mean) * (s[i] - mean);
@@ -56,9 +56,7 @@ class ThoraxForceField final : public ForceField {
 
   void stiffness_product(const std::vector<Vec3>& q, std::vector<Vec3>& kq) override {
     inner_->stiffness_product(q, kq);
-    std::vector<Vec3> face(m_.thorax_node.size());
-    for (std::size_t i = 0; i < face.size(); ++i) face[i] = q[std::size_t(m_.thorax_node[i])];
-    add_product(face, kq, 1.0);
+    add_product(q, nullptr, kq, 1.0);
   }
 
   // K_jj = a_j a_jᵀ / C + n nᵀ (k_j (1 − 2 w_j) + w_j² Σk): the diagonal of both terms' K.
@@ -89,18 +87,14 @@ class ThoraxForceField final : public ForceField {
   // The device's Newton holds no dense block: the host solves (newton_linear_solver.h), as with contact.
 
  private:
-  /// The face nodes' displacements at x.
-  std::vector<Vec3> displacements(const std::vector<Vec3>& x) const {
-    std::vector<Vec3> u(m_.thorax_node.size());
-    for (std::size_t i = 0; i < u.size(); ++i) {
+  /// n · (y_i − origin_i) over the face's nodes i: their normal displacements for y = x and origin the
+  /// rest shape, or a direction's normal components for origin null.
+  std::vector<double> normal_components(const std::vector<Vec3>& y, const std::vector<Vec3>* origin) const {
+    std::vector<double> s(m_.thorax_node.size());
+    for (std::size_t i = 0; i < s.size(); ++i) {
       const std::size_t n = std::size_t(m_.thorax_node[i]);
-      u[i] = x[n] - m_.rest_m[n];
+      s[i] = normal_.dot(origin ? Vec3(y[n] - (*origin)[n]) : y[n]);
     }
-    return u;
-  }
-  std::vector<double> normal_displacements(const std::vector<Vec3>& u) const {
-    std::vector<double> s(u.size());
-    for (std::size_t i = 0; i < u.size(); ++i) s[i] = normal_.dot(u[i]);
     return s;
   }
   double weighted_mean(const std::vector<double>& s) const {
@@ -108,9 +102,10 @@ class ThoraxForceField final : public ForceField {
     for (std::size_t i = 0; i < s.size(); ++i) mean += weight_[i] * s[i];
     return mean;
   }
-  /// out[node] += sign · K u over the face's nodes, u their displacements (or a direction).
-  void add_product(const std::vector<Vec3>& u, std::vector<Vec3>& out, double sign) const {
-    const std::vector<double> s = normal_displacements(u);
+  /// out += sign · K (y − origin) over the face's nodes (normal_components): with y = x and the rest
+  /// shape, minus the forces; with a direction and no origin, the stiffness product.
+  void add_product(const std::vector<Vec3>& y, const std::vector<Vec3>* origin, std::vector<Vec3>& out, double sign) const {
+    const std::vector<double> s = normal_components(y, origin);
     const double mean = weighted_mean(s);
     double k_r = 0.0;   // Σ k_i (s_i − s̄)
     for (std::size_t i = 0; i < s.size(); ++i) k_r += k_[i] * (s[i] - mean);
