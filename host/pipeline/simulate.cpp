@@ -103,7 +103,7 @@ void solve_simulation(const Scene& scene, Simulation& sim, const SolveHooks& hoo
   std::shared_ptr<ocl::Context> ctx;
   if (device.use_opencl) ctx = ocl::Context::shared(device);
   SolveOptions base = solve_options_from_scene(scene);
-  if (ctx && device_implements(base)) log::info("solving on " + ctx->info().spec() + " " + ctx->info().name);
+  if (ctx && device_shortfall(base, &sim.mesh).empty()) log::info("solving on " + ctx->info().spec() + " " + ctx->info().name);
   // With gravity compensated the solver's rest shape is the unloaded one, and every solve starts at
   // the CT (its equilibrium under gravity); displacements stay measured from the CT (sim.mesh).
   std::optional<Mesh> unloaded;

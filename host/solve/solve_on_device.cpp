@@ -21,14 +21,20 @@ bool device_implements(const SolveOptions& opt) {
   return opt.method == SolverMethod::Newton ? fem : !fem;
 }
 
-std::string device_shortfall(const SolveOptions& opt) {
-  if (device_implements(opt)) return "";
-  const bool ties = opt.forces.tie_interface || opt.forces.tie_attached;
-  return std::string("OpenCL solves newton on the finite elements, and the other schemes on the springs without "
-                     "contact or bonded interfaces; not ") +
-         enum_name(opt.method) + " with " + enum_name(opt.forces.material) +
-         (opt.forces.contact_stiffness > 0.0 ? " and contact" : "") +
-         (ties ? " and bonded interfaces (mesh.attached_labels)" : "");
+std::string device_shortfall(const SolveOptions& opt, const Mesh* m) {
+  if (!device_implements(opt)) {
+    const bool ties = opt.forces.tie_interface || opt.forces.tie_attached;
+    return std::string("OpenCL solves newton on the finite elements, and the other schemes on the springs without "
+                       "contact or bonded interfaces; not ") +
+           enum_name(opt.method) + " with " + enum_name(opt.forces.material) +
+           (opt.forces.contact_stiffness > 0.0 ? " and contact" : "") +
+           (ties ? " and bonded interfaces (mesh.attached_labels)" : "");
+  }
+  // The springs' device schemes hold no chest beyond a cut (thorax_beyond_cut.h), which only the mesh knows.
+  if (m && opt.forces.material == MaterialModel::Msd && !m->thorax_node.empty())
+    return "the springs on OpenCL have no chest beyond the CT's cranial cut (material.thorax_compliance_l_per_cmh2o "
+           "null slides the cut instead)";
+  return "";
 }
 
 namespace {
@@ -44,16 +50,6 @@ void require_device_solves(const std::string& device, const SolveOptions& opt) {
   if (!why.empty()) refuse_device(device, why);
 }
 
-namespace {
-/// Why OpenCL cannot solve on this mesh what it implements for the options ("" when it can): the
-/// springs' device schemes hold no chest beyond a cut (thorax_beyond_cut.h), which only the mesh knows.
-std::string mesh_shortfall(const Mesh& m, const SolveOptions& opt) {
-  if (opt.forces.material != MaterialModel::Msd || m.thorax_node.empty()) return "";
-  return "the springs on OpenCL have no chest beyond the CT's cranial cut (material.thorax_compliance_l_per_cmh2o "
-         "0 holds the cut instead)";
-}
-}  // namespace
-
 std::unique_ptr<ForceField> make_device_force_field(ocl::Context& ctx, const Mesh& m, const ForceModel& model) {
   return with_thorax_beyond_cut(
       m, with_interface_tie(m, model, with_contact(m, model, make_fem_force_field_cl(ctx, m, model.material))));
@@ -61,7 +57,8 @@ std::unique_ptr<ForceField> make_device_force_field(ocl::Context& ctx, const Mes
 
 SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions& opt,
                             const std::vector<Vec3>& x_start) {
-  if (ctx && device_implements(opt) && mesh_shortfall(m, opt).empty()) {
+  const std::string why = ctx ? device_shortfall(opt, &m) : "";
+  if (ctx && why.empty()) {
     SolveResult r;
     if (opt.method != SolverMethod::Newton) {
       r = solve_opencl(*ctx, m, opt, x_start);
@@ -74,7 +71,6 @@ SolveResult solve_on_device(ocl::Context* ctx, const Mesh& m, const SolveOptions
   }
   std::string fallback;
   if (ctx) {
-    const std::string why = device_implements(opt) ? mesh_shortfall(m, opt) : device_shortfall(opt);
     if (!opt.allow_cpu_fallback) refuse_device(ctx->info().spec(), why);
     fallback = ctx->info().spec() + ": " + why;
     static std::atomic<bool> said{false};

@@ -15,8 +15,9 @@ namespace pneumo {
 /// the host); Newton on the springs runs on the CPU.
 bool device_implements(const SolveOptions& opt);
 
-/// Why OpenCL cannot solve these options ("" when it can): one sentence naming what it does solve.
-std::string device_shortfall(const SolveOptions& opt);
+/// Why OpenCL cannot solve these options ("" when it can): one sentence naming what it does solve. With
+/// the mesh, also what only the mesh says (the springs have no chest beyond a cut on the device).
+std::string device_shortfall(const SolveOptions& opt, const Mesh* m = nullptr);
 
 /// InputError when OpenCL device `device` (its spec, as the user wrote or the context names it)
 /// cannot solve these options and opt.allow_cpu_fallback is not set: the one refusal, shared by
