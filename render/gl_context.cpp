@@ -213,10 +213,20 @@ struct GlContext::Impl {
   }
 };
 
+namespace {
+constexpr GlBackend kGlBackends[] = {GlBackend::Auto, GlBackend::EglDevice, GlBackend::EglSurfaceless, GlBackend::OSMesa};
+}  // namespace
+
+std::string gl_backend_names() {
+  std::string names;
+  for (GlBackend b : kGlBackends) names += (names.empty() ? "" : ", ") + std::string(gl_backend_name(b));
+  return names;
+}
+
 GlBackend parse_gl_backend(const std::string& name) {
-  for (GlBackend b : {GlBackend::Auto, GlBackend::EglDevice, GlBackend::EglSurfaceless, GlBackend::OSMesa})
+  for (GlBackend b : kGlBackends)
     if (name == gl_backend_name(b)) return b;
-  throw InputError("OpenGL back end '" + name + "' is not one of: auto, egl-device, egl-surfaceless, osmesa");
+  throw InputError("OpenGL back end '" + name + "' is not one of: " + gl_backend_names());
 }
 
 const char* gl_backend_name(GlBackend b) {

@@ -15,9 +15,11 @@ namespace pneumo {
 
 enum class GlBackend { Auto, EglDevice, EglSurfaceless, OSMesa };
 
-/// "auto" | "egl-device" | "egl-surfaceless" | "osmesa"; anything else is an InputError.
+/// "auto" | "egl-device" | "egl-surfaceless" | "osmesa"; anything else is an InputError naming them.
 GlBackend parse_gl_backend(const std::string& name);
 const char* gl_backend_name(GlBackend b);
+/// Every back end's name, in the order Auto tries them after itself: "auto, egl-device, …".
+std::string gl_backend_names();
 
 struct GlContextInfo {
   GlBackend backend = GlBackend::Auto;  // the one in use (never Auto)

@@ -1,35 +1,17 @@
 #include "cli/gl_backend_option.h"
 
-#include "core/error.h"
+#include "cli/option_check.h"
 #include "render/gl_context.h"
 
 namespace pneumo::cli {
 
-namespace {
-std::string backend_names() {
-  std::string names;
-  for (GlBackend b : {GlBackend::Auto, GlBackend::EglDevice, GlBackend::EglSurfaceless, GlBackend::OSMesa})
-    names += (names.empty() ? "" : ", ") + std::string(gl_backend_name(b));
-  return names;
-}
-}  // namespace
-
 CLI::Option* add_gl_backend_option(CLI::App* cmd, std::string& backend, const std::string& what) {
   return cmd
       ->add_option("--backend", backend,
-                   "Offscreen OpenGL for " + what + ": " + backend_names() +
+                   "Offscreen OpenGL for " + what + ": " + gl_backend_names() +
                        " (auto: a GPU's EGL device, else EGL without a display, else OSMesa)")
       ->capture_default_str()
-      ->check(CLI::Validator(
-          [](std::string& value) -> std::string {
-            try {
-              (void)parse_gl_backend(value);
-              return "";
-            } catch (const InputError& e) {
-              return e.what();
-            }
-          },
-          "BACKEND", "backend"));
+      ->check(checked_by([](const std::string& value) { (void)parse_gl_backend(value); }, "backend"));
 }
 
 }  // namespace pneumo::cli
