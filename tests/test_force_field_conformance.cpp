@@ -253,6 +253,28 @@ TEST_P(ForceFieldConformance, TheStiffnessIsTheForcesJacobian) {
   }
 }
 
+TEST_P(ForceFieldConformance, TheTermUnderTestActsInItsCase) {
+  // A term that does not act in the case would pass every check above by its absence: the fibres, the
+  // contact (pressed 0.3 mm), the ties and the chest (nodes on the top cut) must change the forces of the
+  // bare law by more than 1e-3 of the largest force.
+  const std::string kind = kind_.name;
+  if (on_device() || (kind != "fibres" && kind != "contact" && kind != "ties" && kind != "chest"))
+    GTEST_SKIP() << "no added term, or checked on the host";
+  Mesh bare_mesh = case_.mesh;
+  bare_mesh.tet_fibre.clear();
+  bare_mesh.tet_fibre_k1_pa.clear();
+  bare_mesh.thorax_node.clear();
+  bare_mesh.thorax_area_m2.clear();
+  ForceModel bare_model = case_.model;
+  bare_model.contact_stiffness = 0.0;
+  bare_model.tie_interface = false;
+  auto bare = make_force_field(bare_mesh, bare_model);
+  const std::vector<Vec3> with = forces(*host_, case_.model, case_.x), without = forces(*bare, bare_model, case_.x);
+  double change = 0.0;
+  for (std::size_t n = 0; n < with.size(); ++n) change = std::max(change, (with[n] - without[n]).norm());
+  EXPECT_GT(change, 1e-3 * max_norm(with)) << kind << ": the term does not act in this case";
+}
+
 TEST_P(ForceFieldConformance, TheDeviceGivesTheHostsForcesEnergyAndProduct) {
   if (!on_device()) GTEST_SKIP() << "the host is the reference";
   const ForceModel& model = case_.model;

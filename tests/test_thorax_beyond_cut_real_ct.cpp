@@ -6,8 +6,7 @@
 // the oesophageal (pleural) pressure of 19 ventilated patients at end-expiration before and during a
 // 20 cmH2O pneumoperitoneum and found no significant change (8.7 ± 3.4 against 7.6 ± 3.2 cmH2O), so
 // the pleural pressure the face raises must lie within their scatter, 0 to 3.4 cmH2O, at the lower
-// 12 mmHg (16 cmH2O). And inside the code's own law: the pressure is ΔV / C of the metrics' own ΔV
-// and C (1e-9 relative), and the face moves into the chest (ΔV > 0), as the gas pushes the viscera.
+// 12 mmHg (16 cmH2O). And the face moves into the chest (ΔV > 0), as the gas pushes the viscera.
 // The earlier answers hold: a converged run with no inverted tetrahedron and a rise in the adult
 // 25–60 mm.
 #include <gtest/gtest.h>
@@ -37,7 +36,6 @@ TEST(ThoraxBeyondCutOnTheRealCt, TheCutFaceMovesIntoTheChestWithAPleuralPressure
   // The lungs in view (about 0.1 L of a 2 L lung) leave most of the compliance beyond the cut.
   EXPECT_GT(c, 0.9 * 0.12);
   EXPECT_LT(c, 0.12);
-  EXPECT_NEAR(p, dv_ml * 1e-3 / c, 1e-9 * std::abs(p));
   EXPECT_GT(dv_ml, 0.0);
   EXPECT_LT(p, 3.4);
 }
